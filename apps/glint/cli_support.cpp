@@ -1,0 +1,69 @@
+#include "cli_support.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+
+#include "core/error.h"
+
+namespace glint::app {
+namespace {
+
+bool is_point_cloud_file(const std::filesystem::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  for (const char* known : {".ply", ".xyz", ".pts", ".txt", ".csv", ".pcd"}) {
+    if (extension == known) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::vector<std::string> expand_point_cloud_inputs(const std::vector<std::string>& paths) {
+  std::vector<std::string> files;
+  for (const std::string& path : paths) {
+    if (std::filesystem::is_directory(path)) {
+      std::vector<std::string> found;
+      for (const auto& entry : std::filesystem::recursive_directory_iterator(path)) {
+        if (entry.is_regular_file() && is_point_cloud_file(entry.path())) {
+          found.push_back(entry.path().string());
+        }
+      }
+      std::sort(found.begin(), found.end());
+      if (found.empty()) throw Error(path, "", "folder holds no point-cloud file");
+      files.insert(files.end(), found.begin(), found.end());
+    } else if (std::filesystem::exists(path)) {
+      files.push_back(path);
+    } else {
+      throw Error(path, "", "no such file or folder");
+    }
+  }
+  return files;
+}
+
+std::string models_directory() {
+  if (const char* env = std::getenv("GLINT_MODELS")) return env;
+  return GLINT_SOURCE_MODELS_DIR;
+}
+
+std::string default_edges_model(int classes) {
+  return models_directory() + (classes == 2 ? "/bounded-2c.json" : "/bounded-3c.json");
+}
+
+namespace {
+std::string recorded_command_line;
+}
+
+void remember_command_line(int argc, char** argv) {
+  recorded_command_line.clear();
+  for (int i = 0; i < argc; ++i) {
+    if (i > 0) recorded_command_line += ' ';
+    recorded_command_line += argv[i];
+  }
+}
+
+const std::string& command_line() { return recorded_command_line; }
+
+}  // namespace glint::app

@@ -1,0 +1,24 @@
+#pragma once
+// Each subcommand registers itself on its parent CLI11 app.
+#include <CLI/CLI.hpp>
+#include <string>
+
+namespace glint::app {
+
+// Options every subcommand shares (--quiet, --threads, --log-level), applied before it runs.
+struct CommonOptions {
+  bool quiet = false;
+  int threads = 0;
+  std::string log_level = "info";
+};
+
+void register_edges_commands(CLI::App& app, const CommonOptions& common);
+
+// `glint edges <name>` subcommands, one file each (apps/glint/edges_<name>.cpp).
+void register_edges_classify(CLI::App& edges);
+void register_edges_features(CLI::App& edges);
+void register_edges_train(CLI::App& edges);
+void register_edges_synth(CLI::App& edges);
+void register_edges_eval(CLI::App& edges);
+
+}  // namespace glint::app

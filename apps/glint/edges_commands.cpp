@@ -1,0 +1,14 @@
+#include "commands.h"
+
+namespace glint::app {
+
+void register_edges_commands(CLI::App& app, const CommonOptions& common) {
+  CLI::App* edges = app.add_subcommand(
+      "edges",
+      "BoundED: per-point non-edge / sharp-edge / boundary classification of point clouds "
+      "(thesis ch. 5)");
+  edges->require_subcommand(1);
+  // One line per subcommand; each lives in apps/glint/edges_<name>.cpp.
+}
+
+}  // namespace glint::app

@@ -1,0 +1,49 @@
+// glint: one executable, one subcommand per capability. Errors print one line and exit 1.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+#include "cli_support.h"
+#include "commands.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "core/parallel.h"
+#include "core/progress.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "glint - practical real-time reflectance estimation toolkit.\n"
+      "Point-cloud edge/boundary detection (BoundED), and more to come.\n"
+      "Run 'glint <command> --help' for the options of each command."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "glint 0.1.0");
+
+  glint::app::remember_command_line(argc, argv);
+  glint::app::CommonOptions common;
+  app.add_flag("-q,--quiet", common.quiet, "No progress bars")->configurable();
+  app.add_option("--threads", common.threads, "Worker threads (0 = all cores)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--log-level", common.log_level, "trace, debug, info, warn, error, off");
+
+  glint::app::register_edges_commands(app, common);
+
+  std::unique_ptr<tbb::global_control> thread_limit;
+  app.parse_complete_callback([&] {
+    glint::set_quiet(common.quiet);
+    glint::set_log_level(common.log_level);
+    thread_limit = glint::limit_threads(common.threads);
+  });
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const glint::Error& e) {
+    std::fprintf(stderr, "glint: error: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "glint: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

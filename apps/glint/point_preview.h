@@ -1,0 +1,24 @@
+#pragma once
+// A quick look at a coloured point cloud as a PNG: orthographic view, z-buffered square
+// splats, depth shading. For figures and sanity checks, not a renderer.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/point_cloud.h"
+
+namespace glint::app {
+
+struct PreviewParams {
+  int width = 1200;
+  int height = 900;
+  double azimuth_deg = 35;    // rotation of the view around the up axis
+  double elevation_deg = 25;  // angle above the horizontal plane
+  char up_axis = 'z';         // 'y' or 'z'
+};
+
+// colours: 3 bytes (r, g, b) per point. Written atomically (temporary file + rename).
+void write_point_preview(const std::string& path, const PointCloud& cloud,
+                         const std::vector<std::uint8_t>& rgb, const PreviewParams& params = {});
+
+}  // namespace glint::app

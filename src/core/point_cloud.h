@@ -1,0 +1,66 @@
+#pragma once
+// PointCloud: positions as structure of arrays plus named, typed optional per-point attributes
+// (labels, normals, colours, probabilities, anything a PLY vertex property can hold).
+//
+// Positions are float (metres or the file's own unit); clouds with large absolute coordinates
+// (georeferenced scans) should be re-centred before loading into float.
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace glint {
+
+// One attribute column; the alternative held is the attribute's scalar type.
+using AttributeColumn =
+    std::variant<std::vector<std::int8_t>, std::vector<std::uint8_t>, std::vector<std::int16_t>,
+                 std::vector<std::uint16_t>, std::vector<std::int32_t>,
+                 std::vector<std::uint32_t>, std::vector<float>, std::vector<double>>;
+
+struct NamedAttribute {
+  std::string name;
+  AttributeColumn values;
+};
+
+// Number of elements in a column, whatever its type.
+std::size_t column_size(const AttributeColumn& column);
+// Element i of a column converted to double.
+double column_value(const AttributeColumn& column, std::size_t i);
+
+class PointCloud {
+ public:
+  std::vector<float> x, y, z;
+
+  std::size_t size() const { return x.size(); }
+  bool empty() const { return x.empty(); }
+  void resize(std::size_t n);
+  void reserve(std::size_t n);
+  void push_back(float px, float py, float pz);
+  Eigen::Vector3f point(std::size_t i) const { return {x[i], y[i], z[i]}; }
+
+  // Attributes keep their insertion order (it is the order they are written in).
+  const std::vector<NamedAttribute>& attributes() const { return attributes_; }
+  bool has(const std::string& name) const { return find(name) != nullptr; }
+  const AttributeColumn* find(const std::string& name) const;
+
+  // Typed access: nullptr when absent or stored with another type.
+  template <class T>
+  const std::vector<T>* get(const std::string& name) const {
+    const AttributeColumn* column = find(name);
+    return column ? std::get_if<std::vector<T>>(column) : nullptr;
+  }
+
+  // Adds or replaces an attribute; throws glint::Error when its length differs from size().
+  void set(const std::string& name, AttributeColumn values);
+  void remove(const std::string& name);
+
+  // Keeps the points whose mask entry is true (positions and every attribute).
+  PointCloud select(const std::vector<bool>& keep) const;
+
+ private:
+  std::vector<NamedAttribute> attributes_;
+};
+
+}  // namespace glint

@@ -1,0 +1,59 @@
+#pragma once
+// BoundED multi-scale neighbourhood features (thesis §5.4.1–5.4.2, eqs. 5.1–5.21).
+//
+// For every point and every scale k (default 128, 64, 32, 16) twelve values are computed from
+// its k nearest neighbours (the point itself included), in this order:
+//   0-2  sigma_upper(1..3)  singular values of the covariance of the upper subset  eq. (5.13)
+//   3-5  sigma_lower(1..3)  same for the lower subset                               eq. (5.13)
+//   6    d_perp             centre-of-mass distance upper-lower along the normal    eq. (5.9)
+//   7    d_parallel         ... and in the tangent plane                            eq. (5.10)
+//   8    s_perp             point minus neighbourhood centre along the normal       eq. (5.11)
+//   9    s_parallel         ... and in the tangent plane                            eq. (5.12)
+//   10   c_perp             centre of this scale minus centre of the largest scale's
+//                           remaining points, along the largest scale's normal      eq. (5.17)
+//   11   c_parallel         ... and in that tangent plane                           eq. (5.18)
+// All lengths are in the normalised frame of eq. (5.4) of the scale they belong to, so the
+// features do not depend on the cloud's unit or density.
+//
+// Our decisions where the thesis is silent: the normal n (eigenvector of the smallest
+// eigenvalue of the floor(k/2) neighbours closest to the centre, as in the thesis) is oriented
+// so that s_perp >= 0, i.e. the query point lies in the upper half-space. This makes convex
+// and concave creases look alike and removes the sign ambiguity of the eigenvector.
+// An empty subset contributes zeros.
+#include <cstddef>
+#include <vector>
+
+#include "core/point_cloud.h"
+
+namespace glint::edges {
+
+inline constexpr int kFeaturesPerScale = 12;
+
+struct FeatureParams {
+  // Neighbourhood sizes, largest first (the largest one is the k0 of eq. 5.17).
+  std::vector<int> scales{128, 64, 32, 16};
+};
+
+// Row-major features: value(point, scale, feature) at ((point * scales + scale) * 12 + feature).
+struct FeatureMatrix {
+  std::size_t points = 0;
+  int scales = 0;
+  std::vector<float> values;
+
+  std::size_t row_size() const { return static_cast<std::size_t>(scales) * kFeaturesPerScale; }
+  const float* row(std::size_t point) const { return values.data() + point * row_size(); }
+  float* row(std::size_t point) { return values.data() + point * row_size(); }
+  float at(std::size_t point, int scale, int feature) const {
+    return row(point)[scale * kFeaturesPerScale + feature];
+  }
+};
+
+// Computes the features of every point. Throws glint::Error when the cloud has fewer points
+// than the largest scale, a non-finite coordinate, or the scales are not strictly decreasing.
+// Runs in parallel (TBB) and shows a progress bar on a terminal.
+FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& params = {});
+
+// Validates scales (>= 3, strictly decreasing); throws glint::Error naming the problem.
+void check_scales(const std::vector<int>& scales);
+
+}  // namespace glint::edges

@@ -1,0 +1,90 @@
+#pragma once
+// The BoundED classification network (thesis §5.4.2–5.4.3, Fig. 5.4): its definition, fast
+// plain-C++ inference and its JSON model file. Training (libtorch) lives in edges/train.h.
+//
+// Network, for S scales of F = 12 features each and C classes:
+//   input standardisation   x' = (x - mean) / std per input column (S*F values, fixed, not trained)
+//   pairwise fusion         binary tree over the scales as in PCEDNet: a node concatenates two
+//                           vectors and maps them through Linear(2w, fusion_width) + LeakyReLU;
+//                           levels repeat until two vectors remain (S = 4: nodes (s0,s1), (s2,s3))
+//   head                    hidden_layers x [Linear(.., hidden) + LeakyReLU + Dropout(p)]
+//                           then Linear(hidden, C) + softmax (dropout is off at inference)
+// With the defaults (S = 4, F = 12, C = 3) this has 2*300 + 400 + 272 + 272 + 51 = 1,595
+// trainable parameters (the thesis's "1.6k"); with C = 2 it has 1,578.
+//
+// Classes: index = glint point label: 0 non-edge, 1 sharp edge, 2 boundary (C = 3 only).
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "edges/features.h"
+
+namespace glint::edges {
+
+struct ModelConfig {
+  int classes = 3;                         // 3: non-edge/sharp/boundary; 2: non-edge/sharp
+  std::vector<int> scales{128, 64, 32, 16};  // k of each feature scale, as given to the features
+  int fusion_width = 12;                   // outputs of every fusion node
+  int hidden = 16;                         // width of each hidden head layer
+  int hidden_layers = 3;                   // number of hidden head layers
+  float leaky_slope = 0.01f;               // LeakyReLU negative slope
+};
+
+// Throws glint::Error when a config cannot describe a network: classes not 2 or 3, scale
+// count not a power of two >= 2, scales not valid for the features (see check_scales), or a
+// width / layer count / slope out of range.
+void check_config(const ModelConfig& config);
+
+// One fully connected layer: output = weights * input + bias.
+struct DenseLayer {
+  std::string name;             // "fusion<level>.<node>", "hidden<i>" or "output"
+  int inputs = 0;
+  int outputs = 0;
+  std::vector<float> weights;   // outputs x inputs, row-major (the layout of torch's nn::Linear)
+  std::vector<float> bias;      // outputs
+};
+
+// The dense layers a config implies, in evaluation order (fusion level by level, node by node;
+// then the hidden layers; then the output layer), with zero weights.
+std::vector<DenseLayer> make_layers(const ModelConfig& config);
+
+class Model {
+ public:
+  // A network of the given config with zero weights, mean 0 and std 1 (call check_config first
+  // or expect glint::Error).
+  explicit Model(ModelConfig config = {});
+
+  ModelConfig config;
+  std::vector<float> input_mean;  // S*F, column order of FeatureMatrix rows
+  std::vector<float> input_std;   // S*F, each >= kMinInputStd
+  std::vector<DenseLayer> layers;  // see make_layers
+  nlohmann::json training_info = nlohmann::json::object();  // free-form: how it was trained
+
+  static constexpr float kMinInputStd = 1e-6f;
+
+  // Reads and validates a model file (format, version, every key, array sizes, finite values,
+  // layer shapes against the config, the parameter count); throws glint::Error naming the
+  // file and the key.
+  static Model load(const std::string& path);
+  // Writes the model file (JSON, floats with 9 significant digits, so load() is exact).
+  void save(const std::string& path) const;
+  nlohmann::json to_json() const;
+
+  // Trainable parameters (weights and biases; the fixed standardisation is not counted).
+  std::size_t parameter_count() const;
+
+  // Throws glint::Error when the members are inconsistent (config, array sizes, shapes).
+  void check() const;
+
+  // Classifies every point: probabilities (points x classes, row-major) and the argmax label.
+  // Runs in parallel over batches of points. Throws glint::Error when the features have a
+  // different number of scales than the model. Non-finite features give non-finite
+  // probabilities (compute_features never produces them).
+  void predict(const FeatureMatrix& features, std::vector<float>& probabilities,
+               std::vector<std::uint8_t>& labels) const;
+};
+
+}  // namespace glint::edges

@@ -1,0 +1,362 @@
+#include "geometry/neighbourhoods.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <random>
+#include <string>
+
+#include "core/error.h"
+#include "core/parallel.h"
+#include "geometry/kdtree.h"
+
+namespace glint::geometry {
+namespace {
+
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
+// Uniform grid over the cloud with points stored cell by cell (structure of arrays).
+struct Grid {
+  double cell = 1.0;
+  double origin[3] = {0, 0, 0};
+  std::int64_t dims[3] = {1, 1, 1};
+  std::vector<std::uint64_t> cell_keys;    // sorted, one per non-empty cell
+  std::vector<std::uint32_t> cell_begin;   // cells + 1 offsets into the sorted arrays
+  std::vector<std::int32_t> cell_coords;   // 3 per cell
+  std::vector<float> xs, ys, zs;           // positions in cell order
+  std::vector<std::uint32_t> original;     // cloud index of each sorted slot
+  // Open-addressing hash: key -> cell id.
+  std::vector<std::uint64_t> table_keys;
+  std::vector<std::uint32_t> table_cells;
+  std::uint64_t table_mask = 0;
+
+  std::uint64_t key(std::int64_t ix, std::int64_t iy, std::int64_t iz) const {
+    return static_cast<std::uint64_t>((ix * dims[1] + iy) * dims[2] + iz);
+  }
+  std::int64_t coordinate(float value, int axis) const {
+    const auto c = static_cast<std::int64_t>(std::floor((value - origin[axis]) / cell));
+    return std::clamp<std::int64_t>(c, 0, dims[axis] - 1);
+  }
+  static std::uint64_t hash(std::uint64_t key) { return (key * 0x9E3779B97F4A7C15ull) >> 17; }
+  std::int64_t find(std::uint64_t key) const {
+    for (std::uint64_t slot = hash(key) & table_mask;; slot = (slot + 1) & table_mask) {
+      if (table_keys[slot] == key) return table_cells[slot];
+      if (table_keys[slot] == std::numeric_limits<std::uint64_t>::max()) return -1;
+    }
+  }
+};
+
+double quantile(std::vector<double> values, double q) {
+  const auto at = static_cast<std::size_t>(q * static_cast<double>(values.size() - 1));
+  std::nth_element(values.begin(), values.begin() + at, values.end());
+  return values[at];
+}
+
+// A high quantile of the k-th neighbour distance, from a k-d tree over a subsample whose
+// neighbour count is scaled by the sampling rate (surface-like density assumed).
+double estimate_cell_size(const PointCloud& cloud, int k) {
+  const std::size_t n = cloud.size();
+  const std::size_t m = std::min<std::size_t>(n, std::max<std::size_t>(20000, n / 8));
+  // A seeded random subsample: a fixed stride could alias with the file's point order.
+  std::mt19937_64 rng(12345);
+  std::uniform_int_distribution<std::size_t> pick(0, n - 1);
+  PointCloud sample;
+  sample.reserve(m);
+  for (std::size_t j = 0; j < m; ++j) {
+    const std::size_t i = m == n ? j : pick(rng);
+    sample.push_back(cloud.x[i], cloud.y[i], cloud.z[i]);
+  }
+  const int k_sample = static_cast<int>(std::clamp<double>(
+      std::round(double(k) * double(m) / double(n)), 4.0, double(std::min<std::size_t>(m, k))));
+  // The sample's k_sample-th neighbour sits at about the full cloud's (k_sample·n/m)-th; for a
+  // surface the radius grows with the square root of the count.
+  const double correction = std::sqrt(double(k) * double(m) / (double(n) * double(k_sample)));
+  KdTree tree(sample);
+  const std::size_t queries = std::min<std::size_t>(m, 512);
+  std::vector<double> radii(queries);
+  parallel_for(queries, [&](std::size_t q) {
+    const std::size_t i = q * m / queries;
+    const float point[3] = {sample.x[i], sample.y[i], sample.z[i]};
+    std::vector<std::uint32_t> indices(k_sample);
+    std::vector<float> distances(k_sample);
+    const int found = tree.knn(point, k_sample, indices.data(), distances.data());
+    radii[q] = std::sqrt(double(distances[found - 1])) * correction;
+  });
+  return quantile(std::move(radii), 0.9);
+}
+
+Grid build_grid(const PointCloud& cloud, double cell_size) {
+  Grid grid;
+  const std::size_t n = cloud.size();
+  float lo[3] = {kInfinity, kInfinity, kInfinity};
+  float hi[3] = {-kInfinity, -kInfinity, -kInfinity};
+  const std::vector<float>* axes[3] = {&cloud.x, &cloud.y, &cloud.z};
+  for (int a = 0; a < 3; ++a) {
+    const auto [min_it, max_it] = std::minmax_element(axes[a]->begin(), axes[a]->end());
+    lo[a] = *min_it;
+    hi[a] = *max_it;
+  }
+  const double extent = std::max({double(hi[0]) - lo[0], double(hi[1]) - lo[1],
+                                  double(hi[2]) - lo[2]});
+  if (!(cell_size > 0.0) || !std::isfinite(cell_size)) cell_size = extent > 0 ? extent : 1.0;
+  // Keep the key space inside 64 bits: at most 2^20 cells per axis.
+  cell_size = std::max(cell_size, extent / double(1 << 20));
+  grid.cell = cell_size;
+  for (int a = 0; a < 3; ++a) {
+    grid.origin[a] = lo[a];
+    grid.dims[a] = static_cast<std::int64_t>(std::floor((double(hi[a]) - lo[a]) / cell_size)) + 1;
+  }
+
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> slots(n);
+  parallel_for(n, [&](std::size_t i) {
+    slots[i] = {grid.key(grid.coordinate(cloud.x[i], 0), grid.coordinate(cloud.y[i], 1),
+                         grid.coordinate(cloud.z[i], 2)),
+                static_cast<std::uint32_t>(i)};
+  });
+  tbb::parallel_sort(slots.begin(), slots.end());
+
+  grid.xs.resize(n);
+  grid.ys.resize(n);
+  grid.zs.resize(n);
+  grid.original.resize(n);
+  parallel_for(n, [&](std::size_t s) {
+    const std::uint32_t i = slots[s].second;
+    grid.xs[s] = cloud.x[i];
+    grid.ys[s] = cloud.y[i];
+    grid.zs[s] = cloud.z[i];
+    grid.original[s] = i;
+  });
+  for (std::size_t s = 0; s < n; ++s) {
+    if (s == 0 || slots[s].first != slots[s - 1].first) {
+      grid.cell_keys.push_back(slots[s].first);
+      grid.cell_begin.push_back(static_cast<std::uint32_t>(s));
+    }
+  }
+  grid.cell_begin.push_back(static_cast<std::uint32_t>(n));
+
+  const std::size_t cells = grid.cell_keys.size();
+  grid.cell_coords.resize(3 * cells);
+  std::uint64_t capacity = 16;
+  while (capacity < 2 * cells) capacity *= 2;
+  grid.table_mask = capacity - 1;
+  grid.table_keys.assign(capacity, std::numeric_limits<std::uint64_t>::max());
+  grid.table_cells.assign(capacity, 0);
+  for (std::size_t c = 0; c < cells; ++c) {
+    const std::uint64_t key = grid.cell_keys[c];
+    const auto k = static_cast<std::int64_t>(key);
+    grid.cell_coords[3 * c + 0] = static_cast<std::int32_t>(k / (grid.dims[1] * grid.dims[2]));
+    grid.cell_coords[3 * c + 1] = static_cast<std::int32_t>((k / grid.dims[2]) % grid.dims[1]);
+    grid.cell_coords[3 * c + 2] = static_cast<std::int32_t>(k % grid.dims[2]);
+    std::uint64_t slot = Grid::hash(key) & grid.table_mask;
+    while (grid.table_keys[slot] != std::numeric_limits<std::uint64_t>::max()) {
+      slot = (slot + 1) & grid.table_mask;
+    }
+    grid.table_keys[slot] = key;
+    grid.table_cells[slot] = static_cast<std::uint32_t>(c);
+  }
+  return grid;
+}
+
+// Per-thread working memory, reused across cells (no allocation per point).
+struct Scratch {
+  std::vector<float> cx, cy, cz;        // gathered candidates
+  std::vector<std::uint32_t> cslot;     // their sorted-slot index
+  std::vector<float> distances;         // squared distance of each candidate to the query
+  std::vector<std::uint64_t> ranked;    // (squared distance bits << 32) | candidate
+  float previous_kth = 0;               // k-th squared distance of the previous query
+  std::vector<float> dx, dy, dz;        // accepted neighbourhood, relative to the query
+  std::vector<std::uint32_t> indices;
+  std::vector<std::uint32_t> retry;     // sorted slots that need a larger block
+  std::vector<float> fallback_distances;
+};
+
+// Candidate block of `radius` cells around a cell: gathers its points and returns the block's
+// bounds (infinite on sides where the grid ends, since nothing lies beyond).
+void gather_block(const Grid& grid, std::size_t cell, int radius, Scratch& scratch,
+                  double lower[3], double upper[3]) {
+  scratch.cx.clear();
+  scratch.cy.clear();
+  scratch.cz.clear();
+  scratch.cslot.clear();
+  const std::int32_t* c = &grid.cell_coords[3 * cell];
+  std::int64_t from[3], to[3];
+  for (int a = 0; a < 3; ++a) {
+    from[a] = std::max<std::int64_t>(0, c[a] - radius);
+    to[a] = std::min<std::int64_t>(grid.dims[a] - 1, c[a] + radius);
+    lower[a] = from[a] == 0 ? -std::numeric_limits<double>::infinity()
+                            : grid.origin[a] + double(from[a]) * grid.cell;
+    upper[a] = to[a] == grid.dims[a] - 1 ? std::numeric_limits<double>::infinity()
+                                         : grid.origin[a] + double(to[a] + 1) * grid.cell;
+  }
+  for (std::int64_t ix = from[0]; ix <= to[0]; ++ix) {
+    for (std::int64_t iy = from[1]; iy <= to[1]; ++iy) {
+      for (std::int64_t iz = from[2]; iz <= to[2]; ++iz) {
+        const std::int64_t found = grid.find(grid.key(ix, iy, iz));
+        if (found < 0) continue;
+        const std::uint32_t begin = grid.cell_begin[found], end = grid.cell_begin[found + 1];
+        scratch.cx.insert(scratch.cx.end(), grid.xs.begin() + begin, grid.xs.begin() + end);
+        scratch.cy.insert(scratch.cy.end(), grid.ys.begin() + begin, grid.ys.begin() + end);
+        scratch.cz.insert(scratch.cz.end(), grid.zs.begin() + begin, grid.zs.begin() + end);
+        for (std::uint32_t s = begin; s < end; ++s) scratch.cslot.push_back(s);
+      }
+    }
+  }
+}
+
+// Selects the k nearest candidates of the query; false when the k-th lies farther than the
+// block's guaranteed radius (then a candidate outside the block could be closer).
+bool select_from_block(const Grid& grid, std::uint32_t slot, const double lower[3],
+                       const double upper[3], const std::vector<int>& sizes, Scratch& scratch) {
+  const int k = sizes[0];
+  const std::size_t count = scratch.cx.size();
+  if (count < static_cast<std::size_t>(k)) return false;
+  const float qx = grid.xs[slot], qy = grid.ys[slot], qz = grid.zs[slot];
+  const double guaranteed =
+      std::min({qx - lower[0], upper[0] - qx, qy - lower[1], upper[1] - qy, qz - lower[2],
+                upper[2] - qz});
+  scratch.distances.resize(count);
+  scratch.ranked.resize(count);
+  const float* cx = scratch.cx.data();
+  const float* cy = scratch.cy.data();
+  const float* cz = scratch.cz.data();
+  float* distances = scratch.distances.data();
+  for (std::size_t j = 0; j < count; ++j) {
+    const float ex = cx[j] - qx, ey = cy[j] - qy, ez = cz[j] - qz;
+    distances[j] = ex * ex + ey * ey + ez * ez;
+  }
+  // Neighbouring queries have similar k-th distances: keep only candidates inside a margin of
+  // the previous one, so the selection below sorts ~k entries instead of the whole block.
+  std::uint64_t* ranked = scratch.ranked.data();
+  std::size_t kept = 0;
+  if (scratch.previous_kth > 0) {
+    const float limit = scratch.previous_kth * 1.2f;
+    for (std::size_t j = 0; j < count; ++j) {
+      ranked[kept] = (std::uint64_t(std::bit_cast<std::uint32_t>(distances[j])) << 32) | j;
+      kept += distances[j] <= limit;
+    }
+  }
+  if (kept < static_cast<std::size_t>(k)) {
+    for (std::size_t j = 0; j < count; ++j) {
+      ranked[j] = (std::uint64_t(std::bit_cast<std::uint32_t>(distances[j])) << 32) | j;
+    }
+    kept = count;
+  }
+  std::nth_element(ranked, ranked + (k - 1), ranked + kept);
+  const float kth = std::bit_cast<float>(static_cast<std::uint32_t>(ranked[k - 1] >> 32));
+  scratch.previous_kth = kth;
+  if (double(kth) > guaranteed * guaranteed * (1.0 - 1e-6)) return false;
+  for (std::size_t s = 1; s < sizes.size(); ++s) {
+    std::nth_element(ranked, ranked + (sizes[s] - 1), ranked + sizes[s - 1]);
+  }
+  for (int j = 0; j < k; ++j) {
+    const auto candidate = static_cast<std::uint32_t>(ranked[j]);
+    scratch.dx[j] = cx[candidate] - qx;
+    scratch.dy[j] = cy[candidate] - qy;
+    scratch.dz[j] = cz[candidate] - qz;
+    scratch.indices[j] = grid.original[scratch.cslot[candidate]];
+  }
+  return true;
+}
+
+}  // namespace
+
+NeighbourhoodStats for_each_neighbourhood(const PointCloud& cloud,
+                                          const NeighbourhoodParams& params,
+                                          const std::function<void(const Neighbourhood&)>& visit,
+                                          const std::function<void(std::size_t)>& progress) {
+  const std::vector<int>& sizes = params.nested_sizes;
+  if (sizes.empty() || sizes[0] < 1) {
+    throw Error("", "neighbourhood search", "needs at least one neighbourhood size >= 1");
+  }
+  for (std::size_t s = 1; s < sizes.size(); ++s) {
+    if (sizes[s] < 1 || sizes[s] > sizes[s - 1]) {
+      throw Error("", "neighbourhood search", "nested sizes must be positive and non-increasing");
+    }
+  }
+  const int k = sizes[0];
+  if (cloud.size() < static_cast<std::size_t>(k)) {
+    throw Error("", "neighbourhood search",
+                "the cloud has " + std::to_string(cloud.size()) + " points, fewer than k = " +
+                    std::to_string(k));
+  }
+
+  NeighbourhoodStats stats;
+  const double cell = params.cell_size > 0 ? params.cell_size : estimate_cell_size(cloud, k);
+  const Grid grid = build_grid(cloud, cell);
+  stats.cell_size = grid.cell;
+  stats.cells = grid.cell_keys.size();
+
+  std::once_flag tree_built;
+  std::unique_ptr<KdTree> tree;
+  std::atomic<std::size_t> retried{0}, fallbacks{0};
+  tbb::enumerable_thread_specific<Scratch> scratches([k] {
+    Scratch s;
+    s.dx.resize(k);
+    s.dy.resize(k);
+    s.dz.resize(k);
+    s.indices.resize(k);
+    s.fallback_distances.resize(k);
+    return s;
+  });
+
+  auto emit = [&](std::uint32_t slot, Scratch& scratch) {
+    Neighbourhood neighbourhood;
+    neighbourhood.point = grid.original[slot];
+    neighbourhood.size = k;
+    neighbourhood.dx = scratch.dx.data();
+    neighbourhood.dy = scratch.dy.data();
+    neighbourhood.dz = scratch.dz.data();
+    neighbourhood.indices = scratch.indices.data();
+    visit(neighbourhood);
+  };
+
+  parallel_for_chunks(stats.cells, 4, [&](std::size_t first_cell, std::size_t end_cell) {
+    Scratch& scratch = scratches.local();
+    double lower[3], upper[3];
+    std::size_t done = 0;
+    for (std::size_t cell_id = first_cell; cell_id < end_cell; ++cell_id) {
+      const std::uint32_t begin = grid.cell_begin[cell_id], end = grid.cell_begin[cell_id + 1];
+      scratch.retry.clear();
+      gather_block(grid, cell_id, 1, scratch, lower, upper);
+      for (std::uint32_t slot = begin; slot < end; ++slot) {
+        if (select_from_block(grid, slot, lower, upper, sizes, scratch)) {
+          emit(slot, scratch);
+        } else {
+          scratch.retry.push_back(slot);
+        }
+      }
+      if (!scratch.retry.empty()) {
+        retried += scratch.retry.size();
+        gather_block(grid, cell_id, 2, scratch, lower, upper);
+        for (const std::uint32_t slot : scratch.retry) {
+          if (!select_from_block(grid, slot, lower, upper, sizes, scratch)) {
+            // Sparse region or outlier: exact k-d tree query, already sorted by distance.
+            std::call_once(tree_built, [&] { tree = std::make_unique<KdTree>(cloud); });
+            ++fallbacks;
+            const float query[3] = {grid.xs[slot], grid.ys[slot], grid.zs[slot]};
+            tree->knn(query, k, scratch.indices.data(), scratch.fallback_distances.data());
+            for (int j = 0; j < k; ++j) {
+              const std::uint32_t i = scratch.indices[j];
+              scratch.dx[j] = cloud.x[i] - query[0];
+              scratch.dy[j] = cloud.y[i] - query[1];
+              scratch.dz[j] = cloud.z[i] - query[2];
+            }
+          }
+          emit(slot, scratch);
+        }
+      }
+      done += end - begin;
+    }
+    if (progress) progress(done);
+  });
+  stats.retried_queries = retried;
+  stats.fallback_queries = fallbacks;
+  return stats;
+}
+
+}  // namespace glint::geometry

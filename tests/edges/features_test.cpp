@@ -1,0 +1,122 @@
+#include "edges/features.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "core/error.h"
+
+namespace glint::edges {
+namespace {
+
+enum Feature { kSigmaUpper1 = 0, kSigmaLower1 = 3, kDPerp = 6, kDPar, kSPerp, kSPar, kCPerp, kCPar };
+
+// Jittered grid of spacing h on a plane patch, mapped into 3D by `place(u, v)`.
+template <class Place>
+void add_patch(PointCloud& cloud, int nu, int nv, float h, std::mt19937& rng, Place place) {
+  std::uniform_real_distribution<float> jitter(-0.2f * h, 0.2f * h);
+  for (int i = 0; i < nu; ++i) {
+    for (int j = 0; j < nv; ++j) {
+      const Eigen::Vector3f p = place(i * h + jitter(rng), j * h + jitter(rng));
+      cloud.push_back(p.x(), p.y(), p.z());
+    }
+  }
+}
+
+std::size_t nearest_to(const PointCloud& cloud, const Eigen::Vector3f& target) {
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < cloud.size(); ++i) {
+    if ((cloud.point(i) - target).squaredNorm() < (cloud.point(best) - target).squaredNorm()) best = i;
+  }
+  return best;
+}
+
+const float h = 0.01f;
+
+TEST(Features, PlaneInteriorIsFlatAndCentred) {
+  std::mt19937 rng(1);
+  PointCloud plane;
+  add_patch(plane, 60, 60, h, rng, [](float u, float v) { return Eigen::Vector3f(u, v, 0.f); });
+  const FeatureMatrix f = compute_features(plane);
+  ASSERT_EQ(f.points, plane.size());
+  ASSERT_EQ(f.scales, 4);
+  const std::size_t centre = nearest_to(plane, {0.3f, 0.3f, 0.f});
+  for (int s = 0; s < 4; ++s) {
+    EXPECT_NEAR(f.at(centre, s, kDPerp), 0.f, 1e-3f) << "scale " << s;
+    EXPECT_NEAR(f.at(centre, s, kSPerp), 0.f, 1e-3f) << "scale " << s;
+    EXPECT_LT(f.at(centre, s, kSPar), 0.3f) << "scale " << s;
+    EXPECT_NEAR(f.at(centre, s, kCPerp), 0.f, 1e-3f) << "scale " << s;
+  }
+}
+
+TEST(Features, HalfPlaneEdgeHasLargeTangentialOffset) {
+  std::mt19937 rng(2);
+  PointCloud plane;
+  add_patch(plane, 30, 60, h, rng, [](float u, float v) { return Eigen::Vector3f(u, v, 0.f); });
+  const FeatureMatrix f = compute_features(plane);
+  const std::size_t edge = nearest_to(plane, {0.f, 0.3f, 0.f});
+  const std::size_t interior = nearest_to(plane, {0.15f, 0.3f, 0.f});
+  for (int s = 0; s < 4; ++s) {
+    // A half-disc neighbourhood's centre lies 4r/(3π) inside: about 1.1 in normalised units.
+    EXPECT_GT(f.at(edge, s, kSPar), 0.7f) << "scale " << s;
+    EXPECT_LT(f.at(interior, 0, kSPar), 0.3f);
+    EXPECT_NEAR(f.at(edge, s, kSPerp), 0.f, 1e-3f);
+  }
+}
+
+TEST(Features, RightAngleCreaseSeparatesUpperAndLower) {
+  std::mt19937 rng(3);
+  PointCloud crease;  // an L: floor z = 0 (y >= 0) and wall y = 0 (z >= 0), crease on the x axis
+  add_patch(crease, 60, 30, h, rng, [](float u, float v) { return Eigen::Vector3f(u, v + h / 2, 0.f); });
+  add_patch(crease, 60, 30, h, rng, [](float u, float v) { return Eigen::Vector3f(u, 0.f, v + h / 2); });
+  crease.push_back(0.3f, 0.f, 0.f);
+  const std::size_t on_crease = crease.size() - 1;
+  const FeatureMatrix f = compute_features(crease);
+  for (int s = 0; s < 4; ++s) {
+    EXPECT_GT(f.at(on_crease, s, kDPerp), 0.3f) << "scale " << s;
+    float difference = 0, size = 0;
+    for (int i = 0; i < 3; ++i) {
+      const float upper = f.at(on_crease, s, kSigmaUpper1 + i), lower = f.at(on_crease, s, kSigmaLower1 + i);
+      difference += (upper - lower) * (upper - lower);
+      size += upper * upper + lower * lower;
+    }
+    EXPECT_GT(std::sqrt(difference), 0.1f * std::sqrt(size)) << "scale " << s;
+    EXPECT_GE(f.at(on_crease, s, kSPerp), 0.f);  // orientation convention
+  }
+}
+
+TEST(Features, ValuesAreFiniteAndOrderIndependentOfThreads) {
+  std::mt19937 rng(4);
+  PointCloud cloud;
+  add_patch(cloud, 40, 40, h, rng, [](float u, float v) {
+    return Eigen::Vector3f(u, v, 0.1f * std::sin(20 * u));
+  });
+  const FeatureMatrix a = compute_features(cloud);
+  const FeatureMatrix b = compute_features(cloud);
+  ASSERT_EQ(a.values.size(), b.values.size());
+  for (std::size_t i = 0; i < a.values.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(a.values[i]));
+    ASSERT_EQ(a.values[i], b.values[i]);
+  }
+}
+
+TEST(Features, RejectsBadInputs) {
+  PointCloud small;
+  for (int i = 0; i < 100; ++i) small.push_back(float(i), 0.f, float(i % 7));
+  EXPECT_THROW(compute_features(small), glint::Error);  // fewer points than k = 128
+  EXPECT_THROW(compute_features(PointCloud{}), glint::Error);
+  FeatureParams params;
+  params.scales = {32, 64};
+  EXPECT_THROW(compute_features(small, params), glint::Error);  // not decreasing
+  params.scales = {32, 3};
+  EXPECT_THROW(compute_features(small, params), glint::Error);  // too small
+  params.scales = {32, 16};
+  EXPECT_NO_THROW(compute_features(small, params));
+  small.x[5] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_THROW(compute_features(small, params), glint::Error);
+}
+
+}  // namespace
+}  // namespace glint::edges

@@ -1,0 +1,91 @@
+#include "geometry/neighbourhoods.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <random>
+#include <set>
+
+#include "core/error.h"
+#include "geometry/kdtree.h"
+
+namespace glint::geometry {
+namespace {
+
+// Points on a unit sphere surface with a dense cluster and a few far outliers: exercises the
+// 3×3×3 block, the 5×5×5 retry and the k-d tree fallback.
+PointCloud uneven_cloud() {
+  std::mt19937 rng(7);
+  std::normal_distribution<float> g(0.f, 1.f);
+  PointCloud cloud;
+  for (int i = 0; i < 6000; ++i) {
+    float x = g(rng), y = g(rng), z = g(rng);
+    const float r = std::sqrt(x * x + y * y + z * z);
+    const float shrink = i < 1500 ? 0.05f : 1.0f;  // a dense blob
+    cloud.push_back(shrink * x / r, shrink * y / r, shrink * z / r);
+  }
+  for (int i = 0; i < 10; ++i) cloud.push_back(5.f + i, -4.f, 3.f * i);
+  return cloud;
+}
+
+float squared_distance(const PointCloud& c, std::uint32_t a, std::uint32_t b) {
+  const float dx = c.x[a] - c.x[b], dy = c.y[a] - c.y[b], dz = c.z[a] - c.z[b];
+  return dx * dx + dy * dy + dz * dz;
+}
+
+TEST(Neighbourhoods, NestedSetsEqualExactKnn) {
+  const PointCloud cloud = uneven_cloud();
+  const std::vector<int> sizes{64, 32, 8};
+  KdTree tree(cloud);
+  const KnnResult exact = tree.knn_all(sizes[0]);
+
+  std::mutex mutex;
+  std::vector<int> visits(cloud.size(), 0);
+  std::size_t mismatches = 0;
+  NeighbourhoodParams params;
+  params.nested_sizes = sizes;
+  const NeighbourhoodStats stats = for_each_neighbourhood(cloud, params, [&](const Neighbourhood& nb) {
+    std::size_t local_mismatch = 0;
+    for (const int s : sizes) {
+      // The s-th distance must equal the exact s-th distance (ties allow other indices).
+      float worst = 0;
+      for (int j = 0; j < s; ++j) worst = std::max(worst, squared_distance(cloud, nb.point, nb.indices[j]));
+      const float expected = exact.squared_distances[std::size_t(nb.point) * sizes[0] + s - 1];
+      if (std::abs(worst - expected) > 1e-6f * std::max(1.f, expected)) ++local_mismatch;
+    }
+    for (int j = 0; j < nb.size; ++j) {
+      const std::uint32_t i = nb.indices[j];
+      if (std::abs(nb.dx[j] - (cloud.x[i] - cloud.x[nb.point])) > 1e-6f) ++local_mismatch;
+    }
+    std::lock_guard<std::mutex> lock(mutex);
+    ++visits[nb.point];
+    mismatches += local_mismatch;
+  });
+  EXPECT_EQ(mismatches, 0u);
+  EXPECT_TRUE(std::all_of(visits.begin(), visits.end(), [](int v) { return v == 1; }));
+  EXPECT_GT(stats.fallback_queries, 0u);  // the outliers
+  EXPECT_GT(stats.cells, 1u);
+}
+
+TEST(Neighbourhoods, IdenticalPointsAndTinyClouds) {
+  PointCloud same;
+  for (int i = 0; i < 20; ++i) same.push_back(1.f, 2.f, 3.f);
+  NeighbourhoodParams params;
+  params.nested_sizes = {20, 5};
+  std::size_t visited = 0;
+  for_each_neighbourhood(same, params, [&](const Neighbourhood& nb) {
+    EXPECT_EQ(nb.dx[19], 0.f);
+    ++visited;
+  });
+  EXPECT_EQ(visited, 20u);
+
+  params.nested_sizes = {21};
+  EXPECT_THROW(for_each_neighbourhood(same, params, [](const Neighbourhood&) {}), glint::Error);
+  params.nested_sizes = {4, 8};
+  EXPECT_THROW(for_each_neighbourhood(same, params, [](const Neighbourhood&) {}), glint::Error);
+}
+
+}  // namespace
+}  // namespace glint::geometry
