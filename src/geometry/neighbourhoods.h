@@ -3,11 +3,12 @@
 //
 // Why not one k-d tree query per point: at k = 128 a plain k-d tree answers ~70k queries/s on
 // two cores, and storing all lists for 1M points costs 1 GB (thesis §5.5.9 asks for a tailored
-// search). Here points are bucketed in a uniform grid whose cell is about the k-th neighbour
-// distance; all points of one cell share one gathered candidate set (the 3×3×3 block around
-// it, contiguous in memory), distances are computed in a tight loop and the k nearest selected.
-// A query is accepted only when its k-th distance is inside the block's guaranteed radius, so
-// the result is exact; the few that are not (sparse regions, outliers) retry on a 5×5×5 block
+// search). Here points are bucketed in a uniform grid whose cell is about half the k-th
+// neighbour distance; all points of one cell share one gathered candidate set (the 5×5×5
+// block around it, contiguous in memory), distances are computed in a tight loop and the k
+// nearest bucket-sorted, reusing the previous query's k-th distance as the bucket range. A
+// query is accepted only when its k-th distance is inside the block's guaranteed radius, so
+// the result is exact; the few that are not (sparse regions, outliers) retry on a 9×9×9 block
 // and then fall back to a k-d tree. Lists are handed to the visitor and never all stored.
 #include <cstdint>
 #include <functional>
@@ -17,13 +18,12 @@
 
 namespace glint::geometry {
 
-// One point's neighbourhood as seen by a visitor. Neighbours are ordered so that for every
-// nested size s in NeighbourhoodParams::nested_sizes, the first s entries are exactly the s
-// nearest (ties broken arbitrarily); beyond that the order is unspecified.
-// Positions are relative to the query point (better float precision for the statistics).
+// One point's neighbourhood as seen by a visitor: its k nearest points (itself included),
+// nearest first, so the first s entries are the s nearest for every s <= k (ties broken
+// arbitrarily). Positions are relative to the query point (better float precision).
 struct Neighbourhood {
   std::uint32_t point = 0;       // index of the query point in the cloud
-  int size = 0;                  // k = nested_sizes[0]
+  int size = 0;                  // k
   const float* dx = nullptr;     // neighbour position minus query position, `size` entries
   const float* dy = nullptr;
   const float* dz = nullptr;
@@ -31,17 +31,16 @@ struct Neighbourhood {
 };
 
 struct NeighbourhoodParams {
-  // Neighbourhood sizes, largest first; the largest is the k of the search.
-  std::vector<int> nested_sizes{128, 64, 32, 16};
-  // Grid cell size in the cloud's unit; 0 = estimate as a high quantile of the k-th
-  // neighbour distance from a subsample.
+  int k = 128;
+  // Grid cell size in the cloud's unit; 0 = estimate from a subsample (about half a high
+  // quantile of the k-th neighbour distance).
   double cell_size = 0.0;
 };
 
 struct NeighbourhoodStats {
   double cell_size = 0.0;
   std::size_t cells = 0;
-  std::size_t retried_queries = 0;   // needed the 5×5×5 block
+  std::size_t retried_queries = 0;   // needed the 9×9×9 block
   std::size_t fallback_queries = 0;  // needed the k-d tree
 };
 

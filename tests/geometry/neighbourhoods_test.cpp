@@ -35,9 +35,9 @@ float squared_distance(const PointCloud& c, std::uint32_t a, std::uint32_t b) {
   return dx * dx + dy * dy + dz * dz;
 }
 
-TEST(Neighbourhoods, NestedSetsEqualExactKnn) {
+TEST(Neighbourhoods, EveryPrefixEqualsExactKnn) {
   const PointCloud cloud = uneven_cloud();
-  const std::vector<int> sizes{64, 32, 8};
+  const std::vector<int> sizes{64, 32, 8};  // prefixes checked
   KdTree tree(cloud);
   const KnnResult exact = tree.knn_all(sizes[0]);
 
@@ -45,7 +45,7 @@ TEST(Neighbourhoods, NestedSetsEqualExactKnn) {
   std::vector<int> visits(cloud.size(), 0);
   std::size_t mismatches = 0;
   NeighbourhoodParams params;
-  params.nested_sizes = sizes;
+  params.k = sizes[0];
   const NeighbourhoodStats stats = for_each_neighbourhood(cloud, params, [&](const Neighbourhood& nb) {
     std::size_t local_mismatch = 0;
     for (const int s : sizes) {
@@ -73,7 +73,7 @@ TEST(Neighbourhoods, IdenticalPointsAndTinyClouds) {
   PointCloud same;
   for (int i = 0; i < 20; ++i) same.push_back(1.f, 2.f, 3.f);
   NeighbourhoodParams params;
-  params.nested_sizes = {20, 5};
+  params.k = 20;
   std::size_t visited = 0;
   for_each_neighbourhood(same, params, [&](const Neighbourhood& nb) {
     EXPECT_EQ(nb.dx[19], 0.f);
@@ -81,9 +81,9 @@ TEST(Neighbourhoods, IdenticalPointsAndTinyClouds) {
   });
   EXPECT_EQ(visited, 20u);
 
-  params.nested_sizes = {21};
+  params.k = 21;
   EXPECT_THROW(for_each_neighbourhood(same, params, [](const Neighbourhood&) {}), glint::Error);
-  params.nested_sizes = {4, 8};
+  params.k = 0;
   EXPECT_THROW(for_each_neighbourhood(same, params, [](const Neighbourhood&) {}), glint::Error);
 }
 
