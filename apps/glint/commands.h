@@ -12,7 +12,7 @@ struct CommonOptions {
   std::string log_level = "info";
 };
 
-void register_edges_commands(CLI::App& app, const CommonOptions& common);
+void register_edges_commands(CLI::App& app);
 
 // `glint edges <name>` subcommands, one file each (apps/glint/edges_<name>.cpp).
 void register_edges_classify(CLI::App& edges);

@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--log-level", common.log_level, "trace, debug, info, warn, error, off");
 
-  glint::app::register_edges_commands(app, common);
+  glint::app::register_edges_commands(app);
 
   std::unique_ptr<tbb::global_control> thread_limit;
   app.parse_complete_callback([&] {

@@ -78,6 +78,8 @@ class Model {
 
   // Throws glint::Error when the members are inconsistent (config, array sizes, shapes).
   void check() const;
+  // Throws glint::Error when the features do not fit the model (scale count, value count).
+  void check_features(const FeatureMatrix& features) const;
 
   // Classifies every point: probabilities (points x classes, row-major) and the argmax label.
   // Runs in parallel over batches of points. Throws glint::Error when the features have a

@@ -1,0 +1,29 @@
+#pragma once
+// The whole BoundED pass over a cloud: features at the model's scales, then the network.
+#include <cstdint>
+#include <vector>
+
+#include "core/point_cloud.h"
+#include "edges/features.h"
+#include "edges/model.h"
+
+namespace glint::edges {
+
+struct Classification {
+  std::vector<std::uint8_t> labels;  // 0 non-edge, 1 sharp edge, 2 boundary
+  std::vector<float> p_sharp;        // softmax probability of the sharp class
+  std::vector<float> p_boundary;     // of the boundary class (0 for a 2-class model)
+  double features_s = 0;             // wall-clock seconds spent in each stage
+  double inference_s = 0;
+};
+
+// Classifies every point. `scales` overrides the model's neighbourhood sizes (same count;
+// e.g. for a much denser or sparser cloud than the training data); empty = the model's.
+Classification classify(const PointCloud& cloud, const Model& model,
+                        const std::vector<int>& scales = {});
+
+// Adds the DESIGN.md output attributes: uchar scalar_label, float scalar_p_sharp,
+// float scalar_p_boundary, and uchar red/green/blue (red = sharp, green = boundary, grey = rest).
+void attach_classification(PointCloud& cloud, const Classification& result);
+
+}  // namespace glint::edges

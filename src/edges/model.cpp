@@ -1,0 +1,409 @@
+#include "edges/model.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+
+#include "core/error.h"
+#include "core/parallel.h"
+#include "io/json_report.h"
+
+namespace glint::edges {
+namespace {
+
+constexpr const char* kFormatName = "glint-bounded-model";
+constexpr int kFormatVersion = 1;
+// Points per inference batch: activations of a batch stay in L1/L2 cache.
+constexpr std::size_t kBatch = 256;
+
+const std::vector<std::string>& class_names(int classes) {
+  static const std::vector<std::string> three{"non-edge", "sharp-edge", "boundary"};
+  static const std::vector<std::string> two{"non-edge", "sharp-edge"};
+  return classes == 2 ? two : three;
+}
+
+bool is_power_of_two(std::size_t n) { return n != 0 && (n & (n - 1)) == 0; }
+
+// ---- inference kernels; activations are stored feature-major: row r of a batch buffer holds
+// ---- feature r of every point, so the innermost loops run over points and vectorise.
+
+// output rows [0, outputs) = weights * input rows [0, inputs) + bias, for `count` points.
+void apply_dense(const DenseLayer& layer, const float* input, float* output, std::size_t count) {
+  for (int o = 0; o < layer.outputs; ++o) {
+    float* out = output + static_cast<std::size_t>(o) * kBatch;
+    const float bias = layer.bias[o];
+    for (std::size_t b = 0; b < count; ++b) out[b] = bias;
+    const float* weight_row = layer.weights.data() + static_cast<std::size_t>(o) * layer.inputs;
+    for (int i = 0; i < layer.inputs; ++i) {
+      const float weight = weight_row[i];
+      const float* in = input + static_cast<std::size_t>(i) * kBatch;
+      for (std::size_t b = 0; b < count; ++b) out[b] += weight * in[b];
+    }
+  }
+}
+
+void apply_leaky_relu(float* rows, int row_count, std::size_t count, float slope) {
+  for (int r = 0; r < row_count; ++r) {
+    float* row = rows + static_cast<std::size_t>(r) * kBatch;
+    for (std::size_t b = 0; b < count; ++b) row[b] = row[b] > 0.0f ? row[b] : slope * row[b];
+  }
+}
+
+// ---- model file reading: every access names the file and the key on failure.
+
+class FileReader {
+ public:
+  explicit FileReader(std::string path) : path_(std::move(path)) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
+    throw Error(path_, key, reason);
+  }
+
+  const nlohmann::json& member(const nlohmann::json& object, const std::string& key,
+                               const std::string& where) const {
+    const auto it = object.find(key);
+    if (it == object.end()) fail(where, "missing key");
+    return *it;
+  }
+
+  int integer(const nlohmann::json& object, const std::string& key) const {
+    const nlohmann::json& value = member(object, key, key);
+    if (!value.is_number_integer()) fail(key, "expected an integer");
+    return value.get<int>();
+  }
+
+  float finite_float(const nlohmann::json& value, const std::string& where) const {
+    if (!value.is_number()) fail(where, "expected a number, got " + std::string(value.type_name()));
+    // Doubles below 2^128 - 2^103 (FLT_MAX plus half an ulp) round to a finite float.
+    static const double float_limit = std::ldexp(1.0, 128) - std::ldexp(1.0, 103);
+    const double result = value.get<double>();
+    if (!(std::fabs(result) < float_limit)) fail(where, "not a finite float");
+    return static_cast<float>(result);
+  }
+
+  std::vector<float> floats(const nlohmann::json& object, const std::string& key,
+                            std::size_t expected_size, const std::string& where) const {
+    const nlohmann::json& array = member(object, key, where);
+    if (!array.is_array()) fail(where, "expected an array of numbers");
+    if (array.size() != expected_size)
+      fail(where, fmt::format("expected {} values, found {}", expected_size, array.size()));
+    std::vector<float> values(expected_size);
+    for (std::size_t i = 0; i < expected_size; ++i)
+      values[i] = finite_float(array[i], fmt::format("{}[{}]", where, i));
+    return values;
+  }
+
+  std::vector<int> integers(const nlohmann::json& object, const std::string& key) const {
+    const nlohmann::json& array = member(object, key, key);
+    if (!array.is_array()) fail(key, "expected an array of integers");
+    std::vector<int> values;
+    for (const auto& value : array) {
+      if (!value.is_number_integer()) fail(key, "expected an array of integers");
+      values.push_back(value.get<int>());
+    }
+    return values;
+  }
+
+ private:
+  std::string path_;
+};
+
+// A float as the double closest to its 9-significant-digit decimal: the JSON writer prints it
+// with at most 9 digits, and reading it back gives the same float.
+double nine_digits(float value) { return std::strtod(fmt::format("{:.9g}", value).c_str(), nullptr); }
+
+nlohmann::json float_array(const std::vector<float>& values) {
+  nlohmann::json array = nlohmann::json::array();
+  for (float v : values) array.push_back(nine_digits(v));
+  return array;
+}
+
+}  // namespace
+
+void check_config(const ModelConfig& config) {
+  const std::string where = "model config";
+  if (config.classes != 2 && config.classes != 3)
+    throw Error(where, "classes", fmt::format("must be 2 or 3, got {}", config.classes));
+  if (config.scales.size() < 2 || !is_power_of_two(config.scales.size()))
+    throw Error(where, "scales",
+                fmt::format("the pairwise fusion needs a power of two >= 2 scales, got {}",
+                            config.scales.size()));
+  check_scales(config.scales);
+  if (config.fusion_width < 1)
+    throw Error(where, "fusion_width", fmt::format("must be >= 1, got {}", config.fusion_width));
+  if (config.hidden < 1)
+    throw Error(where, "hidden", fmt::format("must be >= 1, got {}", config.hidden));
+  if (config.hidden_layers < 0)
+    throw Error(where, "hidden_layers",
+                fmt::format("must be >= 0, got {}", config.hidden_layers));
+  if (!std::isfinite(config.leaky_slope) || config.leaky_slope < 0.0f || config.leaky_slope >= 1.0f)
+    throw Error(where, "leaky_slope",
+                fmt::format("must be in [0, 1), got {}", config.leaky_slope));
+}
+
+std::vector<DenseLayer> make_layers(const ModelConfig& config) {
+  std::vector<DenseLayer> layers;
+  auto add = [&](std::string name, int inputs, int outputs) {
+    DenseLayer layer;
+    layer.name = std::move(name);
+    layer.inputs = inputs;
+    layer.outputs = outputs;
+    layer.weights.assign(static_cast<std::size_t>(inputs) * outputs, 0.0f);
+    layer.bias.assign(outputs, 0.0f);
+    layers.push_back(std::move(layer));
+  };
+  // Fusion tree: each level halves the number of vectors until two remain.
+  int vectors = static_cast<int>(config.scales.size());
+  int width = kFeaturesPerScale;
+  for (int level = 0; vectors > 2; ++level, vectors /= 2, width = config.fusion_width)
+    for (int node = 0; node < vectors / 2; ++node)
+      add(fmt::format("fusion{}.{}", level, node), 2 * width, config.fusion_width);
+  int inputs = 2 * width;
+  for (int h = 0; h < config.hidden_layers; ++h, inputs = config.hidden)
+    add(fmt::format("hidden{}", h), inputs, config.hidden);
+  add("output", inputs, config.classes);
+  return layers;
+}
+
+Model::Model(ModelConfig model_config) : config(std::move(model_config)) {
+  check_config(config);
+  const std::size_t columns = config.scales.size() * kFeaturesPerScale;
+  input_mean.assign(columns, 0.0f);
+  input_std.assign(columns, 1.0f);
+  layers = make_layers(config);
+}
+
+std::size_t Model::parameter_count() const {
+  std::size_t count = 0;
+  for (const DenseLayer& layer : layers) count += layer.weights.size() + layer.bias.size();
+  return count;
+}
+
+void Model::check() const {
+  check_config(config);
+  const std::string where = "model";
+  const std::size_t columns = config.scales.size() * kFeaturesPerScale;
+  if (input_mean.size() != columns || input_std.size() != columns)
+    throw Error(where, "input_mean/input_std",
+                fmt::format("expected {} values each, have {} and {}", columns, input_mean.size(),
+                            input_std.size()));
+  for (float s : input_std)
+    if (!(s >= kMinInputStd))
+      throw Error(where, "input_std", fmt::format("values must be >= {}", kMinInputStd));
+  const std::vector<DenseLayer> expected = make_layers(config);
+  if (layers.size() != expected.size())
+    throw Error(where, "layers",
+                fmt::format("the config implies {} layers, have {}", expected.size(), layers.size()));
+  for (std::size_t l = 0; l < layers.size(); ++l) {
+    const DenseLayer& layer = layers[l];
+    const DenseLayer& shape = expected[l];
+    if (layer.inputs != shape.inputs || layer.outputs != shape.outputs ||
+        layer.weights.size() != shape.weights.size() || layer.bias.size() != shape.bias.size())
+      throw Error(where, shape.name,
+                  fmt::format("expected {} x {} weights and {} biases", shape.outputs,
+                              shape.inputs, shape.outputs));
+  }
+}
+
+nlohmann::json Model::to_json() const {
+  check();
+  nlohmann::json layer_array = nlohmann::json::array();
+  for (const DenseLayer& layer : layers)
+    layer_array.push_back({{"name", layer.name},
+                           {"inputs", layer.inputs},
+                           {"outputs", layer.outputs},
+                           {"weights", float_array(layer.weights)},
+                           {"bias", float_array(layer.bias)}});
+  return {{"format", kFormatName},
+          {"version", kFormatVersion},
+          {"classes", class_names(config.classes)},
+          {"scales", config.scales},
+          {"features_per_scale", kFeaturesPerScale},
+          {"fusion_width", config.fusion_width},
+          {"hidden", config.hidden},
+          {"hidden_layers", config.hidden_layers},
+          {"leaky_slope", nine_digits(config.leaky_slope)},
+          {"parameter_count", parameter_count()},
+          {"input_mean", float_array(input_mean)},
+          {"input_std", float_array(input_std)},
+          {"layers", layer_array},
+          {"training", training_info.is_null() ? nlohmann::json::object() : training_info}};
+}
+
+void Model::save(const std::string& path) const { io::write_json(path, to_json()); }
+
+Model Model::load(const std::string& path) {
+  const FileReader reader(path);
+  std::ifstream stream(path);
+  if (!stream) throw Error(path, "", "cannot open the model file");
+  nlohmann::json root;
+  try {
+    root = nlohmann::json::parse(stream);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(path, "", std::string("not a valid JSON file: ") + e.what());
+  }
+  if (!root.is_object()) reader.fail("", "expected a JSON object at the top level");
+
+  const nlohmann::json& format = reader.member(root, "format", "format");
+  if (!format.is_string() || format.get<std::string>() != kFormatName)
+    reader.fail("format", fmt::format("expected \"{}\"", kFormatName));
+  if (const int version = reader.integer(root, "version"); version != kFormatVersion)
+    reader.fail("version", fmt::format("unsupported version {} (this glint reads {})", version,
+                                       kFormatVersion));
+
+  const nlohmann::json& classes = reader.member(root, "classes", "classes");
+  if (!classes.is_array() || (classes.size() != 2 && classes.size() != 3))
+    reader.fail("classes", "expected a list of 2 or 3 class names");
+  const int class_count = static_cast<int>(classes.size());
+  if (classes != nlohmann::json(class_names(class_count)))
+    reader.fail("classes", fmt::format("expected {}", nlohmann::json(class_names(class_count)).dump()));
+
+  if (const int features = reader.integer(root, "features_per_scale"); features != kFeaturesPerScale)
+    reader.fail("features_per_scale",
+                fmt::format("expected {}, got {}", kFeaturesPerScale, features));
+
+  ModelConfig config;
+  config.classes = class_count;
+  config.scales = reader.integers(root, "scales");
+  config.fusion_width = reader.integer(root, "fusion_width");
+  config.hidden = reader.integer(root, "hidden");
+  config.hidden_layers = reader.integer(root, "hidden_layers");
+  config.leaky_slope = reader.finite_float(reader.member(root, "leaky_slope", "leaky_slope"),
+                                           "leaky_slope");
+  try {
+    check_config(config);
+  } catch (const Error& e) {
+    reader.fail(e.element(), e.reason());
+  }
+
+  Model model(config);
+  const std::size_t columns = config.scales.size() * kFeaturesPerScale;
+  model.input_mean = reader.floats(root, "input_mean", columns, "input_mean");
+  model.input_std = reader.floats(root, "input_std", columns, "input_std");
+  for (std::size_t c = 0; c < columns; ++c)
+    if (!(model.input_std[c] >= kMinInputStd))
+      reader.fail(fmt::format("input_std[{}]", c), fmt::format("must be >= {}", kMinInputStd));
+
+  const nlohmann::json& layer_array = reader.member(root, "layers", "layers");
+  if (!layer_array.is_array() || layer_array.size() != model.layers.size())
+    reader.fail("layers", fmt::format("expected an array of {} layers", model.layers.size()));
+  for (std::size_t l = 0; l < model.layers.size(); ++l) {
+    DenseLayer& layer = model.layers[l];
+    const nlohmann::json& entry = layer_array[l];
+    const std::string where = fmt::format("layers[{}]", l);
+    if (!entry.is_object()) reader.fail(where, "expected an object");
+    const nlohmann::json& name = reader.member(entry, "name", where + ".name");
+    if (!name.is_string() || name.get<std::string>() != layer.name)
+      reader.fail(where + ".name", fmt::format("expected \"{}\"", layer.name));
+    const nlohmann::json& inputs = reader.member(entry, "inputs", where + ".inputs");
+    const nlohmann::json& outputs = reader.member(entry, "outputs", where + ".outputs");
+    if (inputs != layer.inputs || outputs != layer.outputs)
+      reader.fail(where, fmt::format("the config implies a {} x {} layer", layer.outputs,
+                                     layer.inputs));
+    layer.weights = reader.floats(entry, "weights", layer.weights.size(), where + ".weights");
+    layer.bias = reader.floats(entry, "bias", layer.bias.size(), where + ".bias");
+  }
+
+  const nlohmann::json& count = reader.member(root, "parameter_count", "parameter_count");
+  if (!count.is_number_unsigned() || count.get<std::size_t>() != model.parameter_count())
+    reader.fail("parameter_count",
+                fmt::format("the layers hold {} parameters", model.parameter_count()));
+
+  if (const auto training = root.find("training"); training != root.end()) {
+    if (!training->is_object()) reader.fail("training", "expected an object");
+    model.training_info = *training;
+  }
+  return model;
+}
+
+void Model::check_features(const FeatureMatrix& features) const {
+  const int scales = static_cast<int>(config.scales.size());
+  if (features.scales != scales)
+    throw Error("features", "scales",
+                fmt::format("the model expects {} scales, the features have {}", scales,
+                            features.scales));
+  if (features.values.size() != features.points * features.row_size())
+    throw Error("features", "values",
+                fmt::format("expected {} values for {} points, have {}",
+                            features.points * features.row_size(), features.points,
+                            features.values.size()));
+}
+
+void Model::predict(const FeatureMatrix& features, std::vector<float>& probabilities,
+                    std::vector<std::uint8_t>& labels) const {
+  check();
+  check_features(features);
+  const int scales = static_cast<int>(config.scales.size());
+  const std::size_t columns = features.row_size();
+
+  const std::size_t classes = static_cast<std::size_t>(config.classes);
+  probabilities.resize(features.points * classes);
+  labels.resize(features.points);
+
+  std::size_t widest = columns;
+  for (const DenseLayer& layer : layers)
+    widest = std::max(widest, static_cast<std::size_t>(layer.outputs));
+
+  parallel_for_chunks(features.points, kBatch, [&](std::size_t chunk_begin, std::size_t chunk_end) {
+    std::vector<float> buffer_a(widest * kBatch), buffer_b(widest * kBatch);
+    for (std::size_t begin = chunk_begin; begin < chunk_end; begin += kBatch) {
+      const std::size_t count = std::min(kBatch, chunk_end - begin);
+      float* current = buffer_a.data();
+      float* next = buffer_b.data();
+
+      // Standardised inputs, transposed to feature-major.
+      for (std::size_t b = 0; b < count; ++b) {
+        const float* row = features.row(begin + b);
+        for (std::size_t c = 0; c < columns; ++c)
+          current[c * kBatch + b] = (row[c] - input_mean[c]) / input_std[c];
+      }
+
+      // Fusion tree: node j of a level reads vectors 2j and 2j+1 (adjacent rows) and writes
+      // vector j of the next level.
+      std::size_t layer_index = 0;
+      int width = kFeaturesPerScale;
+      for (int vectors = scales; vectors > 2; vectors /= 2, width = config.fusion_width) {
+        for (int node = 0; node < vectors / 2; ++node) {
+          const DenseLayer& layer = layers[layer_index++];
+          float* out = next + static_cast<std::size_t>(node) * layer.outputs * kBatch;
+          apply_dense(layer, current + static_cast<std::size_t>(2 * node) * width * kBatch, out,
+                      count);
+          apply_leaky_relu(out, layer.outputs, count, config.leaky_slope);
+        }
+        std::swap(current, next);
+      }
+      // Head.
+      for (int h = 0; h < config.hidden_layers; ++h) {
+        const DenseLayer& layer = layers[layer_index++];
+        apply_dense(layer, current, next, count);
+        apply_leaky_relu(next, layer.outputs, count, config.leaky_slope);
+        std::swap(current, next);
+      }
+      apply_dense(layers[layer_index], current, next, count);
+
+      // Softmax and argmax per point.
+      for (std::size_t b = 0; b < count; ++b) {
+        float* out = probabilities.data() + (begin + b) * classes;
+        float max_logit = next[b];
+        std::size_t best = 0;
+        for (std::size_t c = 1; c < classes; ++c)
+          if (next[c * kBatch + b] > max_logit) {
+            max_logit = next[c * kBatch + b];
+            best = c;
+          }
+        float sum = 0.0f;
+        for (std::size_t c = 0; c < classes; ++c) {
+          out[c] = std::exp(next[c * kBatch + b] - max_logit);
+          sum += out[c];
+        }
+        for (std::size_t c = 0; c < classes; ++c) out[c] /= sum;
+        labels[begin + b] = static_cast<std::uint8_t>(best);
+      }
+    }
+  });
+}
+
+}  // namespace glint::edges

@@ -1,0 +1,114 @@
+// The glint executable end to end: synth -> train -> classify -> eval, and its error contract
+// (one line naming the file, exit code 1, no output left behind).
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "io/point_cloud_io.h"
+
+namespace glint {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CommandResult {
+  int exit_code;
+  std::string output;  // stdout and stderr
+};
+
+CommandResult glint(const std::string& arguments) {
+  const fs::path log = fs::temp_directory_path() / "glint_cli_test.log";
+  const std::string command = std::string(GLINT_BINARY) + " --quiet " + arguments + " > " +
+                              log.string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  std::ifstream stream(log);
+  return {WEXITSTATUS(status), std::string(std::istreambuf_iterator<char>(stream), {})};
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    folder_ = fs::temp_directory_path() / "glint_cli_test";
+    fs::remove_all(folder_);
+    fs::create_directories(folder_);
+  }
+  static std::string path(const std::string& name) { return (folder_ / name).string(); }
+  static fs::path folder_;
+};
+fs::path CliTest::folder_;
+
+TEST_F(CliTest, SynthTrainClassifyEval) {
+  const CommandResult synth = glint("edges synth -o " + path("clouds") +
+                          " --count 4 --seed 5 --min-points 1500 --max-points 2500 --shapes box,sheet");
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  ASSERT_TRUE(fs::exists(path("clouds/manifest.json")));
+
+  const CommandResult train = glint("edges train " + path("clouds") + " --iterations 30 --batch 1024 --seed 3 -o " +
+                          path("model.json") + " --report " + path("train.json"));
+  ASSERT_EQ(train.exit_code, 0) << train.output;
+  const auto model = nlohmann::json::parse(std::ifstream(path("model.json")));
+  EXPECT_EQ(model["parameter_count"], 1595);
+  EXPECT_EQ(model["training"]["seed"], 3);
+
+  std::string first_cloud;
+  for (const auto& entry : fs::directory_iterator(path("clouds")))
+    if (entry.path().extension() == ".ply") first_cloud = entry.path().string();
+  const CommandResult classify = glint("edges classify " + first_cloud + " -o " + path("out.ply") + " --model " +
+                             path("model.json") + " --png " + path("out.png") + " --report " +
+                             path("classify.json"));
+  ASSERT_EQ(classify.exit_code, 0) << classify.output;
+  const PointCloud out = io::read_point_cloud(path("out.ply"));
+  EXPECT_TRUE(out.get<std::uint8_t>("scalar_label"));
+  EXPECT_TRUE(out.get<float>("scalar_p_sharp"));
+  EXPECT_TRUE(out.get<float>("scalar_p_boundary"));
+  EXPECT_TRUE(out.get<std::uint8_t>("red"));
+  EXPECT_TRUE(out.get<std::uint8_t>("label"));  // the input's own properties are kept
+  EXPECT_GT(fs::file_size(path("out.png")), 0u);
+
+  const CommandResult eval = glint("edges eval " + path("clouds") + " --model " + path("model.json") +
+                         " --report " + path("eval.json"));
+  ASSERT_EQ(eval.exit_code, 0) << eval.output;
+  EXPECT_NE(eval.output.find("median"), std::string::npos) << eval.output;
+  const auto report = nlohmann::json::parse(std::ifstream(path("eval.json")));
+  EXPECT_EQ(report["files"].size(), 4u);
+}
+
+TEST_F(CliTest, BadInputsGiveOneLineAndNoOutput) {
+  const std::string truncated = path("truncated.ply");
+  std::ofstream(truncated) << "ply\nformat binary_little_endian 1.0\nelement vertex 500\n"
+                              "property float x\nproperty float y\nproperty float z\nend_header\n"
+                           << std::string(100, '\0');
+  CommandResult run = glint("edges classify " + truncated + " -o " + path("never.ply"));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.output.find("truncated.ply"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("truncated"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(path("never.ply")));
+
+  const std::string tiny = path("tiny.xyz");
+  std::ofstream(tiny) << "0 0 0\n1 0 0\n0 1 0\n";
+  run = glint("edges classify " + tiny + " -o " + path("never.ply"));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.output.find("tiny.xyz"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(path("never.ply")));
+
+  run = glint("edges classify " + path("missing.ply") + " -o " + path("never.ply"));
+  EXPECT_EQ(run.exit_code, 1);
+  run = glint("edges classify " + tiny + " -o " + path("never.ply") + " --model " + truncated);
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.output.find("truncated.ply"), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, HelpOnEveryLevel) {
+  for (const char* command : {"", "edges", "edges classify", "edges train", "edges synth",
+                              "edges eval", "edges features"}) {
+    const CommandResult run = glint(std::string(command) + " --help");
+    EXPECT_EQ(run.exit_code, 0) << command;
+    EXPECT_NE(run.output.find("Usage"), std::string::npos) << command;
+  }
+}
+
+}  // namespace
+}  // namespace glint
