@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# Runs every benchmark program and collects their JSON in build/bench/.
+#   scripts/bench.sh BUILD DATA
+set -euo pipefail
+BUILD=${1:?usage: bench.sh BUILD DATA}
+DATA=${2:?usage: bench.sh BUILD DATA}
+OUT=build/bench
+mkdir -p "$OUT"
+"$BUILD/bench/edges/edges_throughput" --points 1000000 --model models/bounded-3c.json \
+  --data "$DATA/pointclouds/default-eval" --json "$OUT/edges_throughput.json"
+echo "bench: results in $OUT"

@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# The main job on bundled data: classify a default-eval cloud (PLY + picture), then evaluate
+# both shipped models beside the CA baseline on all of default-eval.
+#   scripts/demo.sh GLINT DATA
+set -euo pipefail
+GLINT=${1:?usage: demo.sh GLINT DATA}
+DATA=${2:?usage: demo.sh GLINT DATA}
+OUT=build/demo
+EVAL="$DATA/pointclouds/default-eval"
+if [[ ! -d "$EVAL" ]]; then
+  echo "demo: $EVAL not found; pass DATA=/path/to/shared/data (or set GLINT_DATA)" >&2
+  exit 1
+fi
+mkdir -p "$OUT"
+"$GLINT" edges classify "$EVAL/CubeFractal2.ply" -o "$OUT/CubeFractal2-edges.ply" \
+  --png "$OUT/CubeFractal2-edges.png" --report "$OUT/classify.json"
+"$GLINT" edges eval "$EVAL" --model models/bounded-3c.json --model models/bounded-2c.json \
+  --report "$OUT/eval-default.json"
+"$GLINT" --quiet edges synth -o "$OUT/heldout" --count 8 --seed 1000
+"$GLINT" edges classify "$OUT/heldout/$(ls "$OUT/heldout" | grep -m1 '\.ply$')" \
+  -o "$OUT/heldout-edges.ply" --png "$OUT/heldout-edges.png"
+"$GLINT" edges eval "$OUT/heldout" --task boundary --no-baseline
+echo "demo: outputs in $OUT"
