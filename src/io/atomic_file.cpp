@@ -6,36 +6,47 @@
 #include <cstring>
 #include <filesystem>
 #include <system_error>
+#include <utility>
 
 #include "core/error.h"
 
 namespace glint::io {
+namespace {
+
+void remove_quietly(const std::string& path) {
+  std::error_code ignored;
+  std::filesystem::remove(path, ignored);
+}
+
+}  // namespace
 
 AtomicFile::AtomicFile(std::string path, bool binary)
     : path_(std::move(path)), temporary_(path_ + ".tmp-" + std::to_string(::getpid())) {
-  stream_.open(temporary_, binary ? std::ios::out | std::ios::binary | std::ios::trunc
-                                  : std::ios::out | std::ios::trunc);
-  if (!stream_) throw Error(path_, "", std::string("cannot create the file: ") + std::strerror(errno));
+  stream_.open(temporary_, binary ? std::ios::out | std::ios::binary : std::ios::out);
+  if (!stream_) {
+    throw Error(path_, "", std::string("cannot create the file: ") + std::strerror(errno));
+  }
 }
 
 AtomicFile::~AtomicFile() {
   if (committed_) return;
   stream_.close();
-  std::error_code ignored;
-  std::filesystem::remove(temporary_, ignored);
+  remove_quietly(temporary_);
 }
 
 void AtomicFile::commit() {
   stream_.flush();
-  const bool written = static_cast<bool>(stream_);
-  stream_.close();
+  const bool written = stream_.good();
+  stream_.close();  // fails when the last buffered bytes cannot be written
+  if (!written || stream_.fail()) {
+    remove_quietly(temporary_);
+    throw Error(path_, "", "writing failed (is the disk full?)");
+  }
   std::error_code error;
-  if (written && !stream_.fail()) std::filesystem::rename(temporary_, path_, error);
-  if (!written || stream_.fail() || error) {
-    std::error_code ignored;
-    std::filesystem::remove(temporary_, ignored);
-    throw Error(path_, "", error ? "cannot rename the finished file into place: " + error.message()
-                                 : std::string("write failed (disk full?)"));
+  std::filesystem::rename(temporary_, path_, error);
+  if (error) {
+    remove_quietly(temporary_);
+    throw Error(path_, "", "cannot move the finished file into place: " + error.message());
   }
   committed_ = true;
 }

@@ -12,17 +12,13 @@ namespace glint::io {
 std::string read_file_bytes(const std::string& path) {
   std::error_code error;
   if (std::filesystem::is_directory(path, error)) throw Error(path, "", "is a folder, not a file");
-  std::ifstream stream(path, std::ios::binary);
+  std::ifstream stream(path, std::ios::binary | std::ios::ate);
   if (!stream) throw Error(path, "", std::string("cannot open the file: ") + std::strerror(errno));
-  std::string bytes;
-  stream.seekg(0, std::ios::end);
   const std::streamoff size = stream.tellg();
-  stream.seekg(0, std::ios::beg);
-  if (size > 0) {
-    bytes.resize(static_cast<std::size_t>(size));
-    stream.read(bytes.data(), size);
-  }
-  if (!stream) throw Error(path, "", "read failed");
+  if (size < 0) throw Error(path, "", "cannot tell the file's size (not a regular file?)");
+  std::string bytes(static_cast<std::size_t>(size), '\0');
+  stream.seekg(0);
+  if (!stream.read(bytes.data(), size)) throw Error(path, "", "reading the file failed");
   return bytes;
 }
 

@@ -1,25 +1,29 @@
 #include "io/json_report.h"
 
-#include <fstream>
-
 #include "core/error.h"
 #include "io/atomic_file.h"
+#include "io/file_bytes.h"
 
 namespace glint::io {
 
 void write_json(const std::string& path, const nlohmann::json& value) {
+  std::string text;
+  try {
+    text = value.dump(2) + '\n';
+  } catch (const nlohmann::json::exception& e) {  // e.g. a string that is not UTF-8
+    throw Error(path, "", std::string("cannot write as JSON: ") + e.what());
+  }
   AtomicFile file(path, false);
-  file.stream() << value.dump(2) << '\n';
+  file.stream() << text;
   file.commit();
 }
 
 nlohmann::json read_json(const std::string& path) {
-  std::ifstream stream(path);
-  if (!stream) throw Error(path, "", "cannot open the file");
+  const std::string text = read_file_bytes(path);
   try {
-    return nlohmann::json::parse(stream);
+    return nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
-    throw Error(path, "byte " + std::to_string(e.byte), "not valid JSON: " + std::string(e.what()));
+    throw Error(path, "byte " + std::to_string(e.byte), std::string("not valid JSON: ") + e.what());
   }
 }
 

@@ -3,56 +3,71 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <array>
 #include <bit>
 #include <cctype>
-#include <charconv>
 #include <cmath>
-#include <cstring>
-#include <fstream>
-#include <limits>
-#include <sstream>
+#include <optional>
+#include <string_view>
+#include <vector>
 
 #include "core/error.h"
 #include "io/atomic_file.h"
+#include "io/codec.h"
 #include "io/file_bytes.h"
 
 namespace glint::io {
 namespace {
 
-enum class Type { int8, uint8, int16, uint16, int32, uint32, float32, float64 };
+// PLY type names, indexed by Scalar: the classic names (which glint writes) and their aliases.
+constexpr std::string_view kTypeNames[] = {"char", "uchar", "short", "ushort",
+                                           "int",  "uint",  "float", "double"};
+constexpr std::string_view kTypeAliases[] = {"int8",  "uint8",  "int16",   "uint16",
+                                             "int32", "uint32", "float32", "float64"};
+constexpr std::string_view kFormatNames[] = {"ascii", "binary_little_endian", "binary_big_endian"};
 
-struct TypeInfo {
-  const char* name;  // the name glint writes
-  const char* alias;
-  int size;
-};
-constexpr TypeInfo kTypes[] = {{"char", "int8", 1},    {"uchar", "uint8", 1},  {"short", "int16", 2},
-                               {"ushort", "uint16", 2}, {"int", "int32", 4},    {"uint", "uint32", 4},
-                               {"float", "float32", 4}, {"double", "float64", 8}};
-
-int size_of(Type type) { return kTypes[static_cast<int>(type)].size; }
-
-bool parse_type(const std::string& name, Type& type) {
-  for (int t = 0; t < 8; ++t)
-    if (name == kTypes[t].name || name == kTypes[t].alias) {
-      type = static_cast<Type>(t);
-      return true;
-    }
-  return false;
+// Whether binary values of `format` are in the opposite byte order to this machine's.
+bool needs_swap(PlyFormat format) {
+  return (format == PlyFormat::binary_big_endian) != (std::endian::native == std::endian::big);
 }
+
+std::string_view type_name(Scalar type) { return kTypeNames[static_cast<int>(type)]; }
+
+std::optional<Scalar> parse_type(std::string_view name) {
+  for (int t = 0; t < 8; ++t) {
+    if (name == kTypeNames[t] || name == kTypeAliases[t]) return static_cast<Scalar>(t);
+  }
+  return std::nullopt;
+}
+
+// ---- header
 
 struct Property {
   std::string name;
-  Type type = Type::float32;
-  bool list = false;
-  Type count_type = Type::uint8;
+  Scalar type = Scalar::float32;      // for lists: the type of the items
+  std::optional<Scalar> list_length;  // for lists: the type of the length prefix
 };
 
 struct Element {
   std::string name;
   std::size_t count = 0;
   std::vector<Property> properties;
+
+  bool has_lists() const {
+    return std::ranges::any_of(properties,
+                               [](const Property& p) { return p.list_length.has_value(); });
+  }
+  // Bytes of one binary record, counting every list as empty.
+  std::size_t least_bytes() const {
+    std::size_t bytes = 0;
+    for (const Property& p : properties) bytes += size_of(p.list_length.value_or(p.type));
+    return bytes;
+  }
+  const Property* find(std::string_view property) const {
+    for (const Property& p : properties) {
+      if (p.name == property) return &p;
+    }
+    return nullptr;
+  }
 };
 
 struct Header {
@@ -61,322 +76,418 @@ struct Header {
   std::size_t body_offset = 0;
 };
 
-std::vector<std::string> split_words(const std::string& line) {
-  std::istringstream stream(line);
-  std::vector<std::string> words;
-  for (std::string word; stream >> word;) words.push_back(word);
-  return words;
+// The line starting at `position` without its line ending; moves `position` past it.
+std::optional<std::string_view> next_line(const std::string& bytes, std::size_t& position) {
+  if (position >= bytes.size()) return std::nullopt;
+  std::size_t end = bytes.find('\n', position);
+  if (end == std::string::npos) end = bytes.size();
+  std::string_view line(bytes.data() + position, end - position);
+  position = end + 1;
+  if (line.ends_with('\r')) line.remove_suffix(1);
+  return line;
 }
 
-Header parse_header(const std::string& path, const std::string& bytes) {
-  Header header;
-  std::size_t position = 0;
-  bool has_format = false;
-  for (int line_number = 1;; ++line_number) {
-    const std::size_t end = bytes.find('\n', position);
-    if (end == std::string::npos) throw Error(path, "header", "no end_header line");
-    std::string line = bytes.substr(position, end - position);
-    position = end + 1;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    const std::string where = fmt::format("header line {}", line_number);
-    if (line_number == 1) {
-      if (line != "ply") throw Error(path, "", "not a PLY file (the first line is not 'ply')");
-      continue;
-    }
-    const std::vector<std::string> words = split_words(line);
-    if (words.empty() || words[0] == "comment" || words[0] == "obj_info") continue;
-    if (words[0] == "end_header") break;
-    if (words[0] == "format") {
-      if (words.size() != 3) throw Error(path, where, "expected 'format <encoding> 1.0'");
-      if (words[1] == "ascii") header.format = PlyFormat::ascii;
-      else if (words[1] == "binary_little_endian") header.format = PlyFormat::binary_little_endian;
-      else if (words[1] == "binary_big_endian") header.format = PlyFormat::binary_big_endian;
-      else throw Error(path, where, "unknown format '" + words[1] + "'");
-      has_format = true;
-    } else if (words[0] == "element") {
-      std::size_t count = 0;
-      if (words.size() != 3 ||
-          std::from_chars(words[2].data(), words[2].data() + words[2].size(), count).ec != std::errc())
-        throw Error(path, where, "expected 'element <name> <count>'");
-      header.elements.push_back({words[1], count, {}});
-    } else if (words[0] == "property") {
-      if (header.elements.empty()) throw Error(path, where, "property before any element");
-      Property property;
-      if (words.size() == 5 && words[1] == "list") {
-        property.list = true;
-        if (!parse_type(words[2], property.count_type) || !parse_type(words[3], property.type))
-          throw Error(path, where, "unknown list property types '" + words[2] + " " + words[3] + "'");
-        property.name = words[4];
-      } else if (words.size() == 3) {
-        if (!parse_type(words[1], property.type))
-          throw Error(path, where, "unknown property type '" + words[1] + "'");
-        property.name = words[2];
-      } else {
-        throw Error(path, where, "expected 'property <type> <name>' or 'property list ...'");
-      }
-      header.elements.back().properties.push_back(property);
-    } else {
-      throw Error(path, where, "unknown header keyword '" + words[0] + "'");
-    }
-  }
-  if (!has_format) throw Error(path, "header", "no format line");
-  header.body_offset = position;
-  return header;
-}
-
-// Whether an ascii value can be stored in `type` (integers: whole and in range).
-bool fits(Type type, double value) {
-  auto in = [value](auto low, auto high) {
-    return value == std::floor(value) && value >= double(low) && value <= double(high);
-  };
-  switch (type) {
-    case Type::int8: return in(INT8_MIN, INT8_MAX);
-    case Type::uint8: return in(0, UINT8_MAX);
-    case Type::int16: return in(INT16_MIN, INT16_MAX);
-    case Type::uint16: return in(0, UINT16_MAX);
-    case Type::int32: return in(INT32_MIN, INT32_MAX);
-    case Type::uint32: return in(0, UINT32_MAX);
-    // Finite doubles below FLT_MAX + half an ulp round to a finite float.
-    case Type::float32: return !std::isfinite(value) || std::fabs(value) < std::ldexp(1.0, 128) - std::ldexp(1.0, 103);
-    case Type::float64: return true;
-  }
-  return false;
-}
-
-// ---- binary decoding
-
-template <class T>
-T load(const char* at, bool swap) {
-  std::array<char, sizeof(T)> raw;
-  std::memcpy(raw.data(), at, sizeof(T));
-  if (swap) std::reverse(raw.begin(), raw.end());
-  return std::bit_cast<T>(raw);
-}
-
-double load_as_double(Type type, const char* at, bool swap) {
-  switch (type) {
-    case Type::int8: return load<std::int8_t>(at, swap);
-    case Type::uint8: return load<std::uint8_t>(at, swap);
-    case Type::int16: return load<std::int16_t>(at, swap);
-    case Type::uint16: return load<std::uint16_t>(at, swap);
-    case Type::int32: return load<std::int32_t>(at, swap);
-    case Type::uint32: return load<std::uint32_t>(at, swap);
-    case Type::float32: return load<float>(at, swap);
-    case Type::float64: return load<double>(at, swap);
-  }
-  return 0.0;
-}
-
-AttributeColumn make_column(Type type, std::size_t n) {
-  switch (type) {
-    case Type::int8: return std::vector<std::int8_t>(n);
-    case Type::uint8: return std::vector<std::uint8_t>(n);
-    case Type::int16: return std::vector<std::int16_t>(n);
-    case Type::uint16: return std::vector<std::uint16_t>(n);
-    case Type::int32: return std::vector<std::int32_t>(n);
-    case Type::uint32: return std::vector<std::uint32_t>(n);
-    case Type::float32: return std::vector<float>(n);
-    case Type::float64: return std::vector<double>(n);
-  }
-  return {};
-}
-
-// Where a vertex property's values go: a position axis, an attribute column, or nowhere (lists).
-struct Sink {
-  int axis = -1;                       // 0, 1, 2 for x, y, z
-  AttributeColumn* column = nullptr;
-  unsigned char* raw = nullptr;        // the column's bytes (native endianness)
-};
-
-class BodyReader {
+class HeaderParser {
  public:
-  BodyReader(const std::string& path, const std::string& bytes, std::size_t offset, PlyFormat format)
-      : path_(path), at_(bytes.data() + offset), end_(bytes.data() + bytes.size()),
-        swap_((format == PlyFormat::binary_big_endian) == (std::endian::native == std::endian::little)),
-        ascii_(format == PlyFormat::ascii) {}
+  explicit HeaderParser(const std::string& path) : path_(path) {}
 
-  std::size_t remaining() const { return static_cast<std::size_t>(end_ - at_); }
-
-  // One value of `type`, as double (ascii or binary).
-  double value(Type type, const Element& element, std::size_t index) {
-    if (ascii_) return ascii_value(type, element, index);
-    const int size = size_of(type);
-    if (remaining() < std::size_t(size)) truncated(element, index);
-    const double result = load_as_double(type, at_, swap_);
-    at_ += size;
-    return result;
-  }
-
-  // Binary only: copies one value's bytes, byte-swapped to native order, to `out`.
-  void raw(Type type, unsigned char* out, const Element& element, std::size_t index) {
-    const int size = size_of(type);
-    if (remaining() < std::size_t(size)) truncated(element, index);
-    std::memcpy(out, at_, size);
-    if (swap_) std::reverse(out, out + size);
-    at_ += size;
-  }
-
-  bool ascii() const { return ascii_; }
-
-  void skip_list(const Property& property, const Element& element, std::size_t index) {
-    const double count = value(property.count_type, element, index);
-    if (!(count >= 0) || count != std::floor(count))
-      throw Error(path_, element_where(element, index), "invalid list length");
-    if (!ascii_) {
-      const std::size_t bytes = static_cast<std::size_t>(count) * size_of(property.type);
-      if (remaining() < bytes) truncated(element, index);
-      at_ += bytes;
-      return;
+  // Takes one header line (already split into words); false once it was "end_header".
+  bool take(const std::vector<std::string_view>& words, int line_number) {
+    where_ = fmt::format("header line {}", line_number);
+    if (words.empty() || words[0] == "comment" || words[0] == "obj_info") return true;
+    if (words[0] == "end_header") return false;
+    if (words[0] == "format") {
+      format(words);
+    } else if (words[0] == "element") {
+      element(words);
+    } else if (words[0] == "property") {
+      property(words);
+    } else {
+      fail(fmt::format("unknown header keyword '{}'", words[0]));
     }
-    for (std::size_t i = 0; i < static_cast<std::size_t>(count); ++i) value(property.type, element, index);
+    return true;
   }
 
-  void skip_element(const Element& element) {
-    bool fixed = !ascii_;
-    std::size_t record = 0;
-    for (const Property& p : element.properties) {
-      fixed = fixed && !p.list;
-      record += size_of(p.type);
-    }
-    if (fixed) {
-      if (element.count > remaining() / std::max<std::size_t>(record, 1)) truncated(element, remaining() / std::max<std::size_t>(record, 1));
-      at_ += element.count * record;
-      return;
-    }
-    for (std::size_t i = 0; i < element.count; ++i)
-      for (const Property& p : element.properties) p.list ? skip_list(p, element, i) : void(value(p.type, element, i));
-  }
-
-  [[noreturn]] void truncated(const Element& element, std::size_t index) const {
-    throw Error(path_, element_where(element, index),
-                fmt::format("file truncated: the header announces {} {} elements", element.count, element.name));
+  Header finish() {
+    if (!has_format_) throw Error(path_, "header", "no format line");
+    return std::move(header_);
   }
 
  private:
-  static std::string element_where(const Element& element, std::size_t index) {
-    return fmt::format("{} {}", element.name, index);
+  [[noreturn]] void fail(const std::string& reason) const { throw Error(path_, where_, reason); }
+
+  void format(const std::vector<std::string_view>& words) {
+    if (words.size() != 3) fail("expected 'format <encoding> <version>'");
+    const auto* found = std::ranges::find(kFormatNames, words[1]);
+    if (found == std::end(kFormatNames)) fail(fmt::format("unknown format '{}'", words[1]));
+    header_.format = static_cast<PlyFormat>(found - std::begin(kFormatNames));
+    has_format_ = true;
   }
 
-  double ascii_value(Type type, const Element& element, std::size_t index) {
-    while (at_ < end_ && std::isspace(static_cast<unsigned char>(*at_))) ++at_;
-    if (at_ == end_) truncated(element, index);
-    const char* token_end = at_;
-    while (token_end < end_ && !std::isspace(static_cast<unsigned char>(*token_end))) ++token_end;
-    double result = 0.0;
-    const auto [stop, ec] = std::from_chars(at_, token_end, result);
-    if (ec != std::errc() || stop != token_end)
-      throw Error(path_, element_where(element, index),
-                  "not a number: '" + std::string(at_, std::min<std::size_t>(token_end - at_, 32)) + "'");
-    if (!fits(type, result))
-      throw Error(path_, element_where(element, index),
-                  fmt::format("{} does not fit the property type {}", std::string(at_, token_end),
-                              kTypes[static_cast<int>(type)].name));
-    at_ = token_end;
-    return result;
+  void element(const std::vector<std::string_view>& words) {
+    Element element;
+    if (words.size() != 3 || !parse_count(words[2], element.count)) {
+      fail("expected 'element <name> <count>'");
+    }
+    element.name = words[1];
+    header_.elements.push_back(std::move(element));
+  }
+
+  void property(const std::vector<std::string_view>& words) {
+    if (header_.elements.empty()) fail("property before any element");
+    Property property;
+    if (words.size() == 5 && words[1] == "list") {
+      property.list_length = parse_type(words[2]);
+      if (!property.list_length) fail(fmt::format("unknown list length type '{}'", words[2]));
+      property.type = known_type(words[3]);
+    } else if (words.size() == 3) {
+      property.type = known_type(words[1]);
+    } else {
+      fail("expected 'property <type> <name>' or 'property list <type> <type> <name>'");
+    }
+    property.name = words.back();
+    header_.elements.back().properties.push_back(std::move(property));
+  }
+
+  Scalar known_type(std::string_view name) const {
+    const std::optional<Scalar> type = parse_type(name);
+    if (!type) fail(fmt::format("unknown property type '{}'", name));
+    return *type;
+  }
+
+  const std::string& path_;
+  std::string where_;
+  Header header_;
+  bool has_format_ = false;
+};
+
+Header parse_header(const std::string& path, const std::string& bytes) {
+  std::size_t position = 0;
+  if (next_line(bytes, position) != "ply") {
+    throw Error(path, "", "not a PLY file (the first line is not 'ply')");
+  }
+  HeaderParser parser(path);
+  for (int line_number = 2;; ++line_number) {
+    const std::optional<std::string_view> line = next_line(bytes, position);
+    if (!line) throw Error(path, "header", "no end_header line");
+    if (!parser.take(split_words(*line), line_number)) break;
+  }
+  Header header = parser.finish();
+  header.body_offset = std::min(position, bytes.size());
+  return header;
+}
+
+// ---- body
+
+// Where one vertex property goes: a position axis, an attribute column, or nowhere (lists).
+struct Slot {
+  const Property* property = nullptr;
+  float* axis = nullptr;
+  AttributeColumn* column = nullptr;
+  char* column_bytes = nullptr;
+};
+
+std::string plural(const Element& element) {
+  return element.name == "vertex" ? "vertices" : fmt::format("'{}' elements", element.name);
+}
+
+std::string record_name(const Element& element, std::size_t index) {
+  return fmt::format("{} {}", element.name, index);
+}
+
+// Elements with nothing to read need no walking (their count may be anything).
+bool is_empty_record(const Element& element) { return element.properties.empty(); }
+
+bool is_list_length(double length) { return length >= 0 && length == std::floor(length); }
+
+class BinaryBody {
+ public:
+  BinaryBody(const std::string& path, std::string_view body, bool swap)
+      : path_(path), at_(body.data()), end_(body.data() + body.size()), swap_(swap) {}
+
+  std::size_t capacity(const Element& element) const {
+    return is_empty_record(element) ? element.count : remaining() / element.least_bytes();
+  }
+
+  double value(Scalar type, const Element& element, std::size_t index) {
+    return decode(type, take(size_of(type), element, index), swap_);
+  }
+
+  void attribute(const Slot& slot, const Element& element, std::size_t index) {
+    const std::size_t size = size_of(slot.property->type);
+    copy_value(take(size, element, index), slot.column_bytes + index * size, size, swap_);
+  }
+
+  void skip_list(const Property& property, const Element& element, std::size_t index) {
+    const double length = value(*property.list_length, element, index);
+    if (!is_list_length(length)) {
+      throw Error(path_, record_name(element, index), "invalid list length");
+    }
+    if (length > double(remaining())) truncated(element, index);
+    take(static_cast<std::size_t>(length) * size_of(property.type), element, index);
+  }
+
+  bool skip_fixed(const Element& element) {
+    if (element.has_lists() || is_empty_record(element)) return is_empty_record(element);
+    const std::size_t records = capacity(element);
+    if (element.count > records) truncated(element, records);
+    at_ += element.count * element.least_bytes();
+    return true;
+  }
+
+  [[noreturn]] void truncated(const Element& element, std::size_t index) const {
+    const std::string record =
+        element.has_lists() ? "" : fmt::format(" of {} bytes", element.least_bytes());
+    throw Error(
+        path_, record_name(element, index),
+        fmt::format("file truncated: expected {} {}{}", element.count, plural(element), record));
+  }
+
+ private:
+  std::size_t remaining() const { return static_cast<std::size_t>(end_ - at_); }
+
+  const char* take(std::size_t size, const Element& element, std::size_t index) {
+    if (remaining() < size) truncated(element, index);
+    const char* start = at_;
+    at_ += size;
+    return start;
   }
 
   const std::string& path_;
   const char* at_;
   const char* end_;
   bool swap_;
-  bool ascii_;
 };
 
-template <class T>
-void store(AttributeColumn& column, std::size_t i, double value) {
-  std::get<std::vector<T>>(column)[i] = static_cast<T>(value);
-}
+class AsciiBody {
+ public:
+  AsciiBody(const std::string& path, std::string_view body)
+      : path_(path), tokens_(body.data(), body.data() + body.size()) {}
 
-void store_value(AttributeColumn& column, Type type, std::size_t i, double value) {
-  switch (type) {
-    case Type::int8: return store<std::int8_t>(column, i, value);
-    case Type::uint8: return store<std::uint8_t>(column, i, value);
-    case Type::int16: return store<std::int16_t>(column, i, value);
-    case Type::uint16: return store<std::uint16_t>(column, i, value);
-    case Type::int32: return store<std::int32_t>(column, i, value);
-    case Type::uint32: return store<std::uint32_t>(column, i, value);
-    case Type::float32: return store<float>(column, i, value);
-    case Type::float64: return store<double>(column, i, value);
+  // A record needs a token per property, and tokens are at least one character and a separator.
+  std::size_t capacity(const Element& element) const {
+    if (is_empty_record(element)) return element.count;
+    return (tokens_.remaining() + 1) / (2 * element.properties.size());
   }
-}
 
-unsigned char* column_bytes(AttributeColumn& column) {
-  return std::visit([](auto& values) { return reinterpret_cast<unsigned char*>(values.data()); }, column);
-}
-
-PointCloud read_vertices(const std::string& path, BodyReader& body, const Element& vertex) {
-  // A record needs at least one byte (binary) or two characters (ascii) per property: a count
-  // beyond that cannot be satisfied, so fail before allocating for it.
-  const std::size_t least = body.ascii() ? 2 : 1;
-  if (vertex.count > body.remaining() / (least * std::max<std::size_t>(vertex.properties.size(), 1)))
-    body.truncated(vertex, body.remaining() / (least * std::max<std::size_t>(vertex.properties.size(), 1)));
-
-  PointCloud cloud;
-  cloud.resize(vertex.count);
-  std::vector<NamedAttribute> attributes;
-  attributes.reserve(vertex.properties.size());
-  std::vector<Sink> sinks(vertex.properties.size());
-  std::vector<Type> position_types(3, Type::float32);
-  bool has_axis[3] = {false, false, false};
-  for (std::size_t p = 0; p < vertex.properties.size(); ++p) {
-    const Property& property = vertex.properties[p];
-    if (property.list) continue;
-    const int axis = property.name == "x" ? 0 : property.name == "y" ? 1 : property.name == "z" ? 2 : -1;
-    if (axis >= 0 && !has_axis[axis]) {
-      sinks[p].axis = axis;
-      has_axis[axis] = true;
-      continue;
+  double value(Scalar type, const Element& element, std::size_t index) {
+    const std::string_view token = tokens_.next();
+    if (token.empty()) truncated(element, index);
+    double result = 0;
+    if (!parse_number(token, result)) {
+      fail(element, index, fmt::format("not a number: '{}'", token.substr(0, 32)));
     }
-    attributes.push_back({property.name, make_column(property.type, vertex.count)});
-  }
-  for (int a = 0; a < 3; ++a)
-    if (!has_axis[a]) throw Error(path, "header", std::string("the vertex element has no ") + "xyz"[a] + " property");
-  for (std::size_t p = 0, a = 0; p < vertex.properties.size(); ++p) {
-    if (vertex.properties[p].list || sinks[p].axis >= 0) continue;
-    sinks[p].column = &attributes[a++].values;
-    sinks[p].raw = column_bytes(*sinks[p].column);
+    if (!fits(type, result)) {
+      fail(element, index,
+           fmt::format("{} does not fit the property type {}", token, type_name(type)));
+    }
+    return result;
   }
 
-  float* axes[3] = {cloud.x.data(), cloud.y.data(), cloud.z.data()};
-  for (std::size_t i = 0; i < vertex.count; ++i) {
-    for (std::size_t p = 0; p < vertex.properties.size(); ++p) {
-      const Property& property = vertex.properties[p];
-      const Sink& sink = sinks[p];
-      if (property.list) {
-        body.skip_list(property, vertex, i);
-      } else if (sink.axis >= 0) {
-        const double value = body.value(property.type, vertex, i);
-        if (!std::isfinite(value)) throw Error(path, fmt::format("vertex {}", i), "non-finite coordinate");
-        axes[sink.axis][i] = static_cast<float>(value);
-      } else if (body.ascii()) {
-        store_value(*sink.column, property.type, i, body.value(property.type, vertex, i));
+  void attribute(const Slot& slot, const Element& element, std::size_t index) {
+    store(*slot.column, index, value(slot.property->type, element, index));
+  }
+
+  void skip_list(const Property& property, const Element& element, std::size_t index) {
+    const double length = value(*property.list_length, element, index);
+    if (!is_list_length(length)) fail(element, index, "invalid list length");
+    for (double item = 0; item < length; ++item) value(property.type, element, index);
+  }
+
+  bool skip_fixed(const Element& element) { return is_empty_record(element); }
+
+  [[noreturn]] void truncated(const Element& element, std::size_t index) const {
+    fail(element, index,
+         fmt::format("file truncated: expected {} {}", element.count, plural(element)));
+  }
+
+ private:
+  [[noreturn]] void fail(const Element& element, std::size_t index,
+                         const std::string& reason) const {
+    throw Error(path_, record_name(element, index), reason);
+  }
+
+  const std::string& path_;
+  Tokens tokens_;
+};
+
+template <class Body>
+void skip_element(Body& body, const Element& element) {
+  if (body.skip_fixed(element)) return;
+  for (std::size_t i = 0; i < element.count; ++i) {
+    for (const Property& property : element.properties) {
+      if (property.list_length) {
+        body.skip_list(property, element, i);
       } else {
-        body.raw(property.type, sink.raw + i * size_of(property.type), vertex, i);
+        body.value(property.type, element, i);
       }
     }
   }
-  for (NamedAttribute& attribute : attributes) cloud.set(attribute.name, std::move(attribute.values));
+}
+
+float coordinate(const std::string& path, double value, std::size_t index) {
+  if (!std::isfinite(value)) {
+    throw Error(path, fmt::format("vertex {}", index), "non-finite coordinate");
+  }
+  if (!fits(Scalar::float32, value)) {
+    throw Error(path, fmt::format("vertex {}", index),
+                fmt::format("coordinate {} is outside the float range", value));
+  }
+  return static_cast<float>(value);
+}
+
+float* axis_of(PointCloud& cloud, const std::string& name) {
+  if (name == "x") return cloud.x.data();
+  if (name == "y") return cloud.y.data();
+  if (name == "z") return cloud.z.data();
+  return nullptr;
+}
+
+// One slot per vertex property; `attributes` receives a column for each non-position scalar.
+std::vector<Slot> plan_slots(const Element& vertex, PointCloud& cloud,
+                             std::vector<NamedAttribute>& attributes) {
+  attributes.reserve(vertex.properties.size());  // the slots point into it
+  std::vector<Slot> slots;
+  for (const Property& property : vertex.properties) {
+    Slot slot{&property};
+    if (!property.list_length) slot.axis = axis_of(cloud, property.name);
+    if (!property.list_length && !slot.axis) {
+      attributes.push_back({property.name, make_column(property.type, cloud.size())});
+      slot.column = &attributes.back().values;
+      slot.column_bytes = column_bytes(*slot.column);
+    }
+    slots.push_back(slot);
+  }
+  return slots;
+}
+
+template <class Body>
+PointCloud read_vertices(const std::string& path, Body& body, const Element& vertex) {
+  // Never allocate for more vertices than the rest of the file could hold.
+  const std::size_t allocated = std::min(vertex.count, body.capacity(vertex));
+  PointCloud cloud;
+  cloud.resize(allocated);
+  std::vector<NamedAttribute> attributes;
+  const std::vector<Slot> slots = plan_slots(vertex, cloud, attributes);
+  for (std::size_t i = 0; i < vertex.count; ++i) {
+    if (i == allocated) body.truncated(vertex, i);
+    for (const Slot& slot : slots) {
+      if (slot.axis) {
+        slot.axis[i] = coordinate(path, body.value(slot.property->type, vertex, i), i);
+      } else if (slot.column) {
+        body.attribute(slot, vertex, i);
+      } else {
+        body.skip_list(*slot.property, vertex, i);
+      }
+    }
+  }
+  for (NamedAttribute& attribute : attributes) {
+    cloud.set(attribute.name, std::move(attribute.values));
+  }
   return cloud;
+}
+
+template <class Body>
+PointCloud read_body(const std::string& path, Body& body, const Header& header,
+                     const Element& vertex) {
+  for (const Element& element : header.elements) {
+    if (&element == &vertex) break;
+    skip_element(body, element);
+  }
+  return read_vertices(path, body, vertex);
+}
+
+// The first name that occurs twice, if any.
+std::optional<std::string> duplicate_name(const std::vector<Property>& properties) {
+  std::vector<std::string_view> names;
+  for (const Property& property : properties) names.push_back(property.name);
+  std::ranges::sort(names);
+  const auto twice = std::ranges::adjacent_find(names);
+  return twice == names.end() ? std::nullopt : std::optional<std::string>(*twice);
+}
+
+// The vertex element, with x, y and z; throws glint::Error when there is none.
+const Element& vertex_element(const std::string& path, const Header& header) {
+  const auto vertex = std::ranges::find(header.elements, "vertex", &Element::name);
+  if (vertex == header.elements.end()) throw Error(path, "header", "no vertex element");
+  if (const auto name = duplicate_name(vertex->properties)) {
+    throw Error(path, "header", fmt::format("duplicate vertex property '{}'", *name));
+  }
+  for (const char* axis : {"x", "y", "z"}) {
+    const Property* property = vertex->find(axis);
+    if (!property || property->list_length) {
+      throw Error(path, "header", fmt::format("the vertex element has no {} property", axis));
+    }
+  }
+  return *vertex;
 }
 
 // ---- writing
 
-Type type_of(const AttributeColumn& column) { return static_cast<Type>(column.index()); }
-
-void write_ascii_value(std::string& out, double value, Type type) {
-  char buffer[64];
-  std::to_chars_result result{};
-  if (type == Type::float32) result = std::to_chars(buffer, buffer + sizeof buffer, static_cast<float>(value));
-  else if (type == Type::float64) result = std::to_chars(buffer, buffer + sizeof buffer, value);
-  else result = std::to_chars(buffer, buffer + sizeof buffer, static_cast<long long>(value));
-  out.append(buffer, result.ptr);
+void check_attribute_names(const std::string& path, const PointCloud& cloud) {
+  for (const NamedAttribute& attribute : cloud.attributes()) {
+    const std::string& name = attribute.name;
+    const bool blank = name.empty() || std::ranges::any_of(name, [](char c) {
+                         return std::isspace(static_cast<unsigned char>(c));
+                       });
+    if (blank || name == "x" || name == "y" || name == "z") {
+      throw Error(path, fmt::format("attribute '{}'", name),
+                  "is not a valid PLY property name (non-empty, no spaces, not x, y or z)");
+    }
+  }
 }
 
-template <class T>
-void put(std::string& out, T value, bool swap) {
-  auto raw = std::bit_cast<std::array<char, sizeof(T)>>(value);
-  if (swap) std::reverse(raw.begin(), raw.end());
-  out.append(raw.data(), raw.size());
+std::string header_text(const PointCloud& cloud, PlyFormat format) {
+  std::string header = fmt::format(
+      "ply\nformat {} 1.0\ncomment generated by glint\nelement vertex {}\n"
+      "property float x\nproperty float y\nproperty float z\n",
+      kFormatNames[static_cast<int>(format)], cloud.size());
+  for (const NamedAttribute& attribute : cloud.attributes()) {
+    header +=
+        fmt::format("property {} {}\n", type_name(scalar_of(attribute.values)), attribute.name);
+  }
+  return header + "end_header\n";
+}
+
+void write_binary_body(std::ostream& out, const PointCloud& cloud, bool swap) {
+  struct Column {
+    const char* bytes;
+    std::size_t size;
+  };
+  std::vector<Column> columns;
+  for (const std::vector<float>* axis : {&cloud.x, &cloud.y, &cloud.z}) {
+    columns.push_back({reinterpret_cast<const char*>(axis->data()), sizeof(float)});
+  }
+  for (const NamedAttribute& attribute : cloud.attributes()) {
+    columns.push_back({column_bytes(attribute.values), size_of(scalar_of(attribute.values))});
+  }
+  std::string buffer;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    for (const Column& column : columns) {
+      buffer.resize(buffer.size() + column.size);
+      copy_value(column.bytes + i * column.size, buffer.data() + buffer.size() - column.size,
+                 column.size, swap);
+    }
+    flush_buffer(buffer, out);
+  }
+  flush_buffer(buffer, out, 0);
+}
+
+void write_ascii_body(std::ostream& out, const PointCloud& cloud) {
+  std::string buffer;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    for (const float value : {cloud.x[i], cloud.y[i], cloud.z[i]}) {
+      append_value(buffer, value);
+      buffer += ' ';
+    }
+    for (const NamedAttribute& attribute : cloud.attributes()) {
+      append_value(buffer, attribute.values, i);
+      buffer += ' ';
+    }
+    buffer.back() = '\n';
+    flush_buffer(buffer, out);
+  }
+  flush_buffer(buffer, out, 0);
 }
 
 }  // namespace
@@ -384,50 +495,25 @@ void put(std::string& out, T value, bool swap) {
 PointCloud read_ply(const std::string& path) {
   const std::string bytes = read_file_bytes(path);
   const Header header = parse_header(path, bytes);
-  BodyReader body(path, bytes, header.body_offset, header.format);
-  for (const Element& element : header.elements) {
-    if (element.name == "vertex") return read_vertices(path, body, element);
-    body.skip_element(element);
+  const Element& vertex = vertex_element(path, header);
+  const std::string_view body = std::string_view(bytes).substr(header.body_offset);
+  if (header.format == PlyFormat::ascii) {
+    AsciiBody ascii(path, body);
+    return read_body(path, ascii, header, vertex);
   }
-  throw Error(path, "header", "no vertex element");
+  BinaryBody binary(path, body, needs_swap(header.format));
+  return read_body(path, binary, header, vertex);
 }
 
 void write_ply(const std::string& path, const PointCloud& cloud, PlyFormat format) {
-  static const char* format_names[] = {"ascii", "binary_little_endian", "binary_big_endian"};
-  std::string out = fmt::format("ply\nformat {} 1.0\ncomment generated by glint\nelement vertex {}\n"
-                                "property float x\nproperty float y\nproperty float z\n",
-                                format_names[static_cast<int>(format)], cloud.size());
-  for (const NamedAttribute& attribute : cloud.attributes())
-    out += fmt::format("property {} {}\n", kTypes[static_cast<int>(type_of(attribute.values))].name,
-                       attribute.name);
-  out += "end_header\n";
-
-  const bool ascii = format == PlyFormat::ascii;
-  const bool swap = (format == PlyFormat::binary_big_endian) == (std::endian::native == std::endian::little);
-  std::size_t record = 12;
-  for (const NamedAttribute& attribute : cloud.attributes()) record += size_of(type_of(attribute.values));
-  out.reserve(out.size() + cloud.size() * (ascii ? 3 * record : record));
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    if (ascii) {
-      for (const float value : {cloud.x[i], cloud.y[i], cloud.z[i]}) {
-        write_ascii_value(out, value, Type::float32);
-        out += ' ';
-      }
-      for (const NamedAttribute& attribute : cloud.attributes()) {
-        write_ascii_value(out, column_value(attribute.values, i), type_of(attribute.values));
-        out += ' ';
-      }
-      out.back() = '\n';
-      continue;
-    }
-    put(out, cloud.x[i], swap);
-    put(out, cloud.y[i], swap);
-    put(out, cloud.z[i], swap);
-    for (const NamedAttribute& attribute : cloud.attributes())
-      std::visit([&](const auto& values) { put(out, values[i], swap); }, attribute.values);
-  }
+  check_attribute_names(path, cloud);
   AtomicFile file(path);
-  file.stream().write(out.data(), static_cast<std::streamsize>(out.size()));
+  file.stream() << header_text(cloud, format);
+  if (format == PlyFormat::ascii) {
+    write_ascii_body(file.stream(), cloud);
+  } else {
+    write_binary_body(file.stream(), cloud, needs_swap(format));
+  }
   file.commit();
 }
 

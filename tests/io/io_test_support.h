@@ -1,8 +1,13 @@
 #pragma once
-// Helpers shared by the io tests: fixture paths and scratch files.
+// Helpers shared by the io tests: fixture paths, scratch files and error capture.
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
+
+#include "core/error.h"
 
 namespace glint::io::test {
 
@@ -10,11 +15,27 @@ inline std::string fixture(const std::string& name) {
   return std::string(GLINT_TEST_DATA_DIR) + "/io/" + name;
 }
 
-// A fresh path in the test's temporary folder.
-inline std::string scratch(const std::string& name) {
-  const auto folder = std::filesystem::temp_directory_path() / "glint_io_tests";
+// The running test's own folder (tests may run in parallel processes), emptied when the test
+// first asks for it.
+inline std::filesystem::path scratch_folder() {
+  const ::testing::TestInfo* test = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string name = std::string(test->test_suite_name()) + "." + test->name();
+  for (char& c : name) {
+    if (c == '/') c = '_';
+  }
+  const auto folder = std::filesystem::temp_directory_path() / "glint_io_tests" / name;
+  static std::string emptied_for;
+  if (emptied_for != name) {
+    std::filesystem::remove_all(folder);
+    emptied_for = name;
+  }
   std::filesystem::create_directories(folder);
-  const auto path = folder / name;
+  return folder;
+}
+
+// A path in the test's folder, with no file there yet.
+inline std::string scratch(const std::string& name) {
+  const auto path = scratch_folder() / name;
   std::filesystem::remove(path);
   return path.string();
 }
@@ -26,6 +47,18 @@ inline void write_text(const std::string& path, const std::string& text) {
 inline std::string read_text(const std::string& path) {
   std::ifstream stream(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(stream), {}};
+}
+
+// The glint::Error that `action` throws (a test failure when it throws none).
+template <class Action>
+Error error_of(Action&& action) {
+  try {
+    action();
+  } catch (const Error& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no glint::Error was thrown";
+  return Error("", "", "no error");
 }
 
 }  // namespace glint::io::test
