@@ -125,10 +125,14 @@ void run_eval(EvalOptions options) {
     const edges::ScoreSummary summary = edges::summarise(per_method[method]);
     print_row("median", method, summary.median);
     summary_json[method] = {{"median", edges::to_json(summary.median)},
-                            {"mean", edges::to_json(summary.mean)}};
+                            {"mean", edges::to_json(summary.mean)},
+                            {"all_points", edges::to_json(summary.pooled)}};
   }
   for (const auto& method : methods) {
     print_row("mean", method, edges::summarise(per_method[method]).mean);
+  }
+  for (const auto& method : methods) {
+    print_row("all points", method, edges::summarise(per_method[method]).pooled);
   }
   if (!options.report.empty()) {
     io::write_json(options.report,

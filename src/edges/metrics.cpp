@@ -56,6 +56,10 @@ BinaryScores score(const std::vector<std::uint8_t>& predicted,
     else if (t) ++s.false_negatives;
     else ++s.true_negatives;
   }
+  return scores_from_counts(s);
+}
+
+BinaryScores scores_from_counts(BinaryScores s) {
   const double tp = double(s.true_positives), fp = double(s.false_positives),
                tn = double(s.true_negatives), fn = double(s.false_negatives);
   if (tp + fp + fn == 0) {
@@ -82,6 +86,13 @@ nlohmann::json to_json(const BinaryScores& s) {
 ScoreSummary summarise(const std::vector<BinaryScores>& per_file) {
   ScoreSummary summary;
   if (per_file.empty()) return summary;
+  for (const auto& s : per_file) {
+    summary.pooled.true_positives += s.true_positives;
+    summary.pooled.false_positives += s.false_positives;
+    summary.pooled.true_negatives += s.true_negatives;
+    summary.pooled.false_negatives += s.false_negatives;
+  }
+  summary.pooled = scores_from_counts(summary.pooled);
   auto reduce = [&](double BinaryScores::*field) {
     std::vector<double> values;
     for (const auto& s : per_file) values.push_back(s.*field);

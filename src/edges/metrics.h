@@ -31,11 +31,15 @@ struct BinaryScores {
 BinaryScores score(const std::vector<std::uint8_t>& predicted,
                    const std::vector<std::uint8_t>& truth, EvalTask task);
 
+// The scores of the confusion counts held in `counts` (the other fields are ignored).
+BinaryScores scores_from_counts(BinaryScores counts);
+
 nlohmann::json to_json(const BinaryScores& scores);
 
-// Median and mean of each score over files.
+// Median and mean of each score over files, and the scores of all points pooled (the counts
+// summed over files: meaningful where many files have no positive at all).
 struct ScoreSummary {
-  BinaryScores median, mean;
+  BinaryScores median, mean, pooled;
 };
 ScoreSummary summarise(const std::vector<BinaryScores>& per_file);
 

@@ -52,5 +52,17 @@ TEST(Metrics, MedianAndMean) {
   EXPECT_DOUBLE_EQ(summary.mean.f1, 0.4);
 }
 
+TEST(Metrics, PooledScoresSumTheCounts) {
+  // File 1 has no positives at all; pooled precision counts its false positive.
+  const auto a = score({1, 1, 0, 0}, {1, 0, 0, 0}, EvalTask::sharp);
+  const auto b = score({1, 0, 0}, {0, 0, 0}, EvalTask::sharp);
+  const ScoreSummary summary = summarise({a, b});
+  EXPECT_EQ(summary.pooled.true_positives, 1u);
+  EXPECT_EQ(summary.pooled.false_positives, 2u);
+  EXPECT_DOUBLE_EQ(summary.pooled.precision, 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(summary.pooled.recall, 1.0);
+  EXPECT_DOUBLE_EQ(summary.pooled.accuracy, 5.0 / 7.0);
+}
+
 }  // namespace
 }  // namespace glint::edges
