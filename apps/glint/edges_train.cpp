@@ -186,6 +186,9 @@ void register_edges_train(CLI::App& edges) {
   command->add_flag("--balance", options->params.balance_classes,
                     "Draw every batch with the classes in equal numbers (default off: uniform "
                     "batches, the focal loss copes with the imbalance as in the thesis)");
+  command->add_flag("!--no-threshold-tuning", options->params.tune_threshold,
+                    "Keep the raw argmax decision (default: after training, shift the non-edge "
+                    "logit to maximise the mean edge-class F1 on the validation points)");
   command->add_option("--notes", options->notes, "Free text stored in the model's training record");
   command->add_option("--report", options->report, "Write a JSON report (inputs, timings, losses)");
   command->callback([options] { run_train(*options); });
