@@ -204,8 +204,9 @@ struct Scratch {
   std::vector<std::uint64_t> ranked;    // (squared distance bits << 32) | candidate
   float previous_kth = 0;               // k-th squared distance of the previous query
   static constexpr int kBuckets = 256;
-  std::vector<std::uint16_t> bucket_of;  // bucket of each candidate (kBuckets = beyond limit)
-  std::array<std::uint32_t, kBuckets + 1> bucket_start{};
+  std::vector<std::uint32_t> within;     // candidates inside the bucket range
+  std::vector<std::uint16_t> bucket_of;  // bucket of each of them
+  std::array<std::uint32_t, kBuckets> bucket_start{};
   std::vector<float> dx, dy, dz;        // accepted neighbourhood, relative to the query
   std::vector<std::uint32_t> indices;
   std::vector<std::uint32_t> retry;     // sorted slots that need a larger block
@@ -258,25 +259,31 @@ inline std::uint64_t pack(float squared_distance, std::size_t candidate) {
 }
 
 // Writes the candidates with squared distance <= limit to `sorted`, in increasing order, and
-// returns how many there are. Counting sort into buckets of equal squared distance, then an
-// insertion sort that only has to fix the order inside each bucket.
+// returns how many there are. They are first compacted (branch-free), then counting-sorted into
+// buckets of equal squared distance, and an insertion sort fixes the order inside each bucket.
 std::size_t bucket_sort_within(const float* distances, std::size_t count, float limit,
                                Scratch& scratch, std::uint64_t* sorted) {
+  scratch.within.resize(count);
+  std::uint32_t* within = scratch.within.data();
+  std::size_t kept = 0;
+  for (std::size_t j = 0; j < count; ++j) {
+    within[kept] = static_cast<std::uint32_t>(j);
+    kept += distances[j] <= limit;
+  }
   constexpr int buckets = Scratch::kBuckets;
-  std::array<std::uint32_t, buckets + 1>& start = scratch.bucket_start;
+  std::array<std::uint32_t, buckets>& start = scratch.bucket_start;
   start.fill(0);
-  scratch.bucket_of.resize(count);
+  scratch.bucket_of.resize(kept);
   std::uint16_t* bucket_of = scratch.bucket_of.data();
   const float to_bucket = float(buckets) / limit;
-  for (std::size_t j = 0; j < count; ++j) {
-    const int b = std::min(int(distances[j] * to_bucket), buckets - 1);
-    bucket_of[j] = static_cast<std::uint16_t>(distances[j] <= limit ? b : buckets);
-    ++start[bucket_of[j]];
+  for (std::size_t i = 0; i < kept; ++i) {
+    bucket_of[i] = static_cast<std::uint16_t>(std::min(int(distances[within[i]] * to_bucket), buckets - 1));
+    ++start[bucket_of[i]];
   }
-  const std::size_t kept = count - start[buckets];
   std::uint32_t offset = 0;
   for (auto& entry : start) offset += std::exchange(entry, offset);
-  for (std::size_t j = 0; j < count; ++j) sorted[start[bucket_of[j]]++] = pack(distances[j], j);
+  for (std::size_t i = 0; i < kept; ++i)
+    sorted[start[bucket_of[i]]++] = pack(distances[within[i]], within[i]);
   for (std::size_t i = 1; i < kept; ++i) {
     const std::uint64_t value = sorted[i];
     std::size_t j = i;
