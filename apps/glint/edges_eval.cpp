@@ -51,7 +51,7 @@ std::string prediction_for(const std::vector<std::string>& predictions, std::siz
 }
 
 void print_row(const std::string& file, const std::string& method, const edges::BinaryScores& s) {
-  fmt::print("{:<28} {:<16} {:>6.3f} {:>6.3f} {:>6.3f} {:>6.3f} {:>6.3f} {:>6.3f}\n", file, method,
+  fmt::print("{:<36} {:<16} {:>6.3f} {:>6.3f} {:>6.3f} {:>6.3f} {:>6.3f} {:>6.3f}\n", file, method,
              s.precision, s.recall, s.mcc, s.f1, s.accuracy, s.iou);
 }
 
@@ -83,7 +83,7 @@ void run_eval(EvalOptions options) {
              task == edges::EvalTask::sharp      ? "sharp edge; boundary counts as negative"
              : task == edges::EvalTask::boundary ? "boundary"
                                                  : "sharp edge or boundary");
-  fmt::print("{:<28} {:<16} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6}\n", "file", "method", "P", "R",
+  fmt::print("{:<36} {:<16} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6}\n", "file", "method", "P", "R",
              "MCC", "F1", "Acc", "IoU");
   for (std::size_t f = 0; f < truth_files.size(); ++f) {
     const std::string& path = truth_files[f];
