@@ -47,11 +47,11 @@ void run_classify(const ClassifyOptions& options) {
   std::size_t counts[3] = {0, 0, 0};
   for (const auto label : result.labels) ++counts[std::min<int>(label, 2)];
   const double total_s = result.features_s + result.inference_s;
-  fmt::print("{}: {} points -> {} non-edge, {} sharp, {} boundary in {:.3f} s "
-             "(features {:.3f} s, network {:.3f} s, {:.0f} points/s) -> {}\n",
-             options.input, cloud.size(), counts[0], counts[1], counts[2], total_s,
-             result.features_s, result.inference_s, double(cloud.size()) / total_s,
-             options.output);
+  fmt::print(
+      "{}: {} points -> {} non-edge, {} sharp, {} boundary in {:.3f} s "
+      "(features {:.3f} s, network {:.3f} s, {:.0f} points/s) -> {}\n",
+      options.input, cloud.size(), counts[0], counts[1], counts[2], total_s, result.features_s,
+      result.inference_s, double(cloud.size()) / total_s, options.output);
 
   if (!options.png.empty()) {
     std::vector<std::uint8_t> rgb(3 * cloud.size());
@@ -65,18 +65,18 @@ void run_classify(const ClassifyOptions& options) {
     fmt::print("picture -> {}\n", options.png);
   }
   if (!options.report.empty()) {
-    io::write_json(options.report,
-                   {{"command", command_line()},
-                    {"input", options.input},
-                    {"output", options.output},
-                    {"model", model_path},
-                    {"scales", options.scales.empty() ? model.config.scales : options.scales},
-                    {"points", cloud.size()},
-                    {"labels", {{"non_edge", counts[0]}, {"sharp", counts[1]}, {"boundary", counts[2]}}},
-                    {"timings_s", {{"features", result.features_s},
-                                   {"network", result.inference_s},
-                                   {"total", total_s}}},
-                    {"points_per_s", double(cloud.size()) / total_s}});
+    io::write_json(
+        options.report,
+        {{"command", command_line()},
+         {"input", options.input},
+         {"output", options.output},
+         {"model", model_path},
+         {"scales", options.scales.empty() ? model.config.scales : options.scales},
+         {"points", cloud.size()},
+         {"labels", {{"non_edge", counts[0]}, {"sharp", counts[1]}, {"boundary", counts[2]}}},
+         {"timings_s",
+          {{"features", result.features_s}, {"network", result.inference_s}, {"total", total_s}}},
+         {"points_per_s", double(cloud.size()) / total_s}});
   }
 }
 
@@ -97,9 +97,10 @@ void register_edges_classify(CLI::App& edges) {
   command->add_option("--model", options->model,
                       "Model JSON (default: the shipped 3-class models/bounded-3c.json; "
                       "models/bounded-2c.json has no boundary class)");
-  command->add_option("--scales", options->scales,
-                      "Override the model's neighbourhood sizes, largest first, e.g. 256,128,64,32 "
-                      "for a cloud much denser than the training data")
+  command
+      ->add_option("--scales", options->scales,
+                   "Override the model's neighbourhood sizes, largest first, e.g. 256,128,64,32 "
+                   "for a cloud much denser than the training data")
       ->delimiter(',');
   command->add_option("--png", options->png, "Also draw the labelled cloud to this PNG");
   command->add_option("--report", options->report, "Write a JSON report (counts, timings)");

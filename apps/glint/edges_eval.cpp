@@ -40,8 +40,8 @@ std::vector<std::uint8_t> labels_of(const PointCloud& cloud, const std::string& 
 std::string prediction_for(const std::vector<std::string>& predictions, std::size_t index,
                            const std::string& truth_path) {
   if (predictions.size() == 1 && std::filesystem::is_directory(predictions[0])) {
-    const auto path = std::filesystem::path(predictions[0]) /
-                      std::filesystem::path(truth_path).filename();
+    const auto path =
+        std::filesystem::path(predictions[0]) / std::filesystem::path(truth_path).filename();
     if (!std::filesystem::exists(path)) {
       throw Error(path.string(), "", "no prediction for " + truth_path);
     }
@@ -58,8 +58,8 @@ void print_row(const std::string& file, const std::string& method, const edges::
 void run_eval(EvalOptions options) {
   const edges::EvalTask task = edges::parse_eval_task(options.task);
   const std::vector<std::string> truth_files = expand_point_cloud_inputs(options.ground_truth);
-  if (!options.predictions.empty() && !(options.predictions.size() == 1 &&
-                                         std::filesystem::is_directory(options.predictions[0])) &&
+  if (!options.predictions.empty() &&
+      !(options.predictions.size() == 1 && std::filesystem::is_directory(options.predictions[0])) &&
       options.predictions.size() != truth_files.size()) {
     throw Error("", "--pred", "give one prediction file per ground-truth file, or one folder");
   }
@@ -135,16 +135,16 @@ void run_eval(EvalOptions options) {
     print_row("all points", method, edges::summarise(per_method[method]).pooled);
   }
   if (!options.report.empty()) {
-    io::write_json(options.report,
-                   {{"command", command_line()},
-                    {"task", options.task},
-                    {"models", options.models},
-                    {"baseline", {{"method", "covariance analysis (Bazazian et al. 2015)"},
-                                  {"k", options.baseline.k},
-                                  {"threshold", options.baseline.threshold},
-                                  {"enabled", !options.no_baseline}}},
-                    {"files", files_json},
-                    {"summary", summary_json}});
+    io::write_json(options.report, {{"command", command_line()},
+                                    {"task", options.task},
+                                    {"models", options.models},
+                                    {"baseline",
+                                     {{"method", "covariance analysis (Bazazian et al. 2015)"},
+                                      {"k", options.baseline.k},
+                                      {"threshold", options.baseline.threshold},
+                                      {"enabled", !options.no_baseline}}},
+                                    {"files", files_json},
+                                    {"summary", summary_json}});
     fmt::print("report -> {}\n", options.report);
   }
 }
@@ -163,20 +163,24 @@ void register_edges_eval(CLI::App& edges) {
       "With neither --model nor --pred the shipped 3-class model is evaluated.\n"
       "Example: glint edges eval ../shared/data/pointclouds/default-eval \\\n"
       "           --model models/bounded-3c.json --model models/bounded-2c.json");
-  command->add_option("ground_truth", options->ground_truth,
-                      "Labelled clouds or folders (label: 0 non-edge, 1 sharp, 2 boundary)")
+  command
+      ->add_option("ground_truth", options->ground_truth,
+                   "Labelled clouds or folders (label: 0 non-edge, 1 sharp, 2 boundary)")
       ->required();
   command->add_option("--model", options->models, "Model JSON to evaluate (repeatable)");
   command->add_option("--pred", options->predictions,
                       "Predicted labels: one file per ground-truth file, or a folder of files "
                       "with the same names");
-  command->add_option("--task", options->task,
-                      "sharp: sharp vs rest (Table 5.1); boundary: boundary vs rest; "
-                      "edge: sharp or boundary vs non-edge")
+  command
+      ->add_option("--task", options->task,
+                   "sharp: sharp vs rest (Table 5.1); boundary: boundary vs rest; "
+                   "edge: sharp or boundary vs non-edge")
       ->capture_default_str();
-  command->add_option("--ca-k", options->baseline.k, "CA neighbourhood size")->capture_default_str();
-  command->add_option("--ca-threshold", options->baseline.threshold,
-                      "CA surface-variation threshold (0.025: thesis, tuned on Default)")
+  command->add_option("--ca-k", options->baseline.k, "CA neighbourhood size")
+      ->capture_default_str();
+  command
+      ->add_option("--ca-threshold", options->baseline.threshold,
+                   "CA surface-variation threshold (0.025: thesis, tuned on Default)")
       ->capture_default_str();
   command->add_flag("--no-baseline", options->no_baseline, "Skip the CA baseline");
   command->add_option("--report", options->report, "Write all scores as JSON");

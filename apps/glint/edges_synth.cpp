@@ -69,22 +69,23 @@ void run_synth(SynthOptions options) {
   for (edges::SynthShape s : options.params.shapes)
     shape_names.push_back(edges::synth_shape_names()[static_cast<std::size_t>(s)]);
   const edges::SynthParams& p = options.params;
-  io::write_json((std::filesystem::path(options.output) / "manifest.json").string(),
-                 {{"command_line", command_line()},
-                  {"seed", p.seed},
-                  {"first_index", options.first},
-                  {"count", options.count},
-                  {"shapes", shape_names},
-                  {"points_range", {p.min_points, p.max_points}},
-                  {"noise_levels", p.noise_levels},
-                  {"outlier_probability", p.outlier_probability},
-                  {"abc_probability", p.abc_probability},
-                  {"gradient_probability", p.gradient_probability},
-                  {"band_spacings", p.band},
-                  {"boundary_band_spacings", p.boundary_band},
-                  {"sharp_angle_degrees", p.sharp_angle_deg},
-                  {"labels", {{"non-edge", counts[0]}, {"sharp-edge", counts[1]}, {"boundary", counts[2]}}},
-                  {"clouds", descriptions}});
+  io::write_json(
+      (std::filesystem::path(options.output) / "manifest.json").string(),
+      {{"command_line", command_line()},
+       {"seed", p.seed},
+       {"first_index", options.first},
+       {"count", options.count},
+       {"shapes", shape_names},
+       {"points_range", {p.min_points, p.max_points}},
+       {"noise_levels", p.noise_levels},
+       {"outlier_probability", p.outlier_probability},
+       {"abc_probability", p.abc_probability},
+       {"gradient_probability", p.gradient_probability},
+       {"band_spacings", p.band},
+       {"boundary_band_spacings", p.boundary_band},
+       {"sharp_angle_degrees", p.sharp_angle_deg},
+       {"labels", {{"non-edge", counts[0]}, {"sharp-edge", counts[1]}, {"boundary", counts[2]}}},
+       {"clouds", descriptions}});
   fmt::print("{}: {} clouds, {} points ({} non-edge, {} sharp, {} boundary), manifest.json\n",
              options.output, options.count, points, counts[0], counts[1], counts[2]);
 }
@@ -95,8 +96,9 @@ void register_edges_synth(CLI::App& edges) {
   auto options = std::make_shared<SynthOptions>();
   edges::SynthParams& p = options->params;
   CLI::App* command = edges.add_subcommand(
-      "synth", "Generate labelled point clouds (creases, boxes, fractal cubes, cylinders, "
-               "cones, sheets with holes, ...) for training and testing");
+      "synth",
+      "Generate labelled point clouds (creases, boxes, fractal cubes, cylinders, "
+      "cones, sheets with holes, ...) for training and testing");
   command->footer(fmt::format(
       "Each cloud is one random shape ({}), scaled to a unit diagonal and rotated at random,\n"
       "written as binary PLY with a uchar 'label' (0 non-edge, 1 sharp edge, 2 boundary) to\n"
@@ -119,29 +121,36 @@ void register_edges_synth(CLI::App& edges) {
       ->delimiter(',');
   command->add_option("--exclude-shapes", options->exclude_shapes, "Shapes never drawn")
       ->delimiter(',');
-  command->add_option("--min-points", p.min_points, "Fewest points per cloud")->capture_default_str();
+  command->add_option("--min-points", p.min_points, "Fewest points per cloud")
+      ->capture_default_str();
   command->add_option("--max-points", p.max_points, "Most points per cloud (log-uniform between)")
       ->capture_default_str();
-  command->add_option("--noise", p.noise_levels,
-                      "Gaussian noise levels (sigma in point spacings); one is drawn per cloud")
+  command
+      ->add_option("--noise", p.noise_levels,
+                   "Gaussian noise levels (sigma in point spacings); one is drawn per cloud")
       ->delimiter(',')
       ->capture_default_str();
-  command->add_option("--outliers", p.outlier_probability,
-                      "Share of clouds with 2-15 % outliers displaced 2-15 spacings")
+  command
+      ->add_option("--outliers", p.outlier_probability,
+                   "Share of clouds with 2-15 % outliers displaced 2-15 spacings")
       ->capture_default_str();
-  command->add_option("--abc", p.abc_probability,
-                      "Share of clouds sampled ABC-like (points exactly on the feature edges)")
+  command
+      ->add_option("--abc", p.abc_probability,
+                   "Share of clouds sampled ABC-like (points exactly on the feature edges)")
       ->capture_default_str();
-  command->add_option("--gradient", p.gradient_probability,
-                      "Share of clouds whose density varies across the shape")
+  command
+      ->add_option("--gradient", p.gradient_probability,
+                   "Share of clouds whose density varies across the shape")
       ->capture_default_str();
   command->add_option("--band", p.band, "Sharp label band half-width in point spacings")
       ->capture_default_str();
-  command->add_option("--boundary-band", p.boundary_band,
-                      "Boundary label band half-width in point spacings")
+  command
+      ->add_option("--boundary-band", p.boundary_band,
+                   "Boundary label band half-width in point spacings")
       ->capture_default_str();
-  command->add_option("--sharp-angle", p.sharp_angle_deg,
-                      "Normal change (degrees) from which a crease is a sharp edge")
+  command
+      ->add_option("--sharp-angle", p.sharp_angle_deg,
+                   "Normal change (degrees) from which a crease is a sharp edge")
       ->capture_default_str();
   command->callback([options] { run_synth(*options); });
 }

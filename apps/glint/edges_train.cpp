@@ -47,8 +47,9 @@ nlohmann::json add_cloud(const std::string& file, const edges::ModelConfig& conf
     labels = io::read_labels(cloud);
   }
   if (!labels)
-    throw Error(file, "", "has no point labels: training needs labelled clouds (0 non-edge, "
-                          "1 sharp edge, 2 boundary)");
+    throw Error(file, "",
+                "has no point labels: training needs labelled clouds (0 non-edge, "
+                "1 sharp edge, 2 boundary)");
   std::size_t counts[3] = {0, 0, 0};
   for (std::size_t i = 0; i < labels->size(); ++i) {
     const std::uint8_t label = (*labels)[i];
@@ -72,9 +73,10 @@ nlohmann::json add_cloud(const std::string& file, const edges::ModelConfig& conf
   for (std::uint8_t label : *labels)  // a 2-class model has no boundary class: boundary -> non-edge
     set.labels.push_back(config.classes == 2 && label == 2 ? 0 : label);
 
-  return {{"file", file},
-          {"points", cloud.size()},
-          {"labels", {{"non-edge", counts[0]}, {"sharp-edge", counts[1]}, {"boundary", counts[2]}}}};
+  return {
+      {"file", file},
+      {"points", cloud.size()},
+      {"labels", {{"non-edge", counts[0]}, {"sharp-edge", counts[1]}, {"boundary", counts[2]}}}};
 }
 
 void run_train(const TrainOptions& options) {
@@ -109,15 +111,14 @@ void run_train(const TrainOptions& options) {
 
   if (!options.report.empty()) {
     timings.add("total", total.elapsed_ms());
-    io::write_json(options.report,
-                   {{"command", "edges train"},
-                    {"command_line", command_line()},
-                    {"inputs", files},
-                    {"excluded", excluded},
-                    {"output", options.output},
-                    {"parameter_count", model.parameter_count()},
-                    {"training", model.training_info},
-                    {"timings_ms", timings.to_json()}});
+    io::write_json(options.report, {{"command", "edges train"},
+                                    {"command_line", command_line()},
+                                    {"inputs", files},
+                                    {"excluded", excluded},
+                                    {"output", options.output},
+                                    {"parameter_count", model.parameter_count()},
+                                    {"training", model.training_info},
+                                    {"timings_ms", timings.to_json()}});
   }
 }
 
@@ -129,7 +130,8 @@ void register_edges_train(CLI::App& edges) {
   CLI::App* command = edges.add_subcommand(
       "train", "Train a BoundED network on labelled point clouds and write a model file (JSON)");
   command->footer(fmt::format(
-      "DATA: point-cloud files or folders (searched recursively for .ply .xyz .pts .txt .csv .pcd)\n"
+      "DATA: point-cloud files or folders (searched recursively for .ply .xyz .pts .txt .csv "
+      ".pcd)\n"
       "whose points carry labels 0 non-edge, 1 sharp edge, 2 boundary (e.g. the output of\n"
       "'glint edges synth' or shared/data/pointclouds/bazazian). Every file must be labelled.\n"
       "Features are computed with the model's --scales; the model file records them, the\n"
@@ -141,20 +143,22 @@ void register_edges_train(CLI::App& edges) {
       "  glint edges train data/train/ --exclude eval_ -o models/my-3c.json --report train.json",
       defaults.focal_gamma, defaults.learning_rate, defaults.batch_size, defaults.iterations,
       100 * defaults.validation_fraction));
-  command->add_option("DATA", options->inputs, "Labelled point-cloud files or folders")
-      ->required();
+  command->add_option("DATA", options->inputs, "Labelled point-cloud files or folders")->required();
   command->add_option("-o,--output", options->output, "Model file to write (.json)")->required();
-  command->add_option("--classes", options->config.classes,
-                      "3: non-edge/sharp/boundary; 2: non-edge/sharp (boundary counts as non-edge)")
+  command
+      ->add_option("--classes", options->config.classes,
+                   "3: non-edge/sharp/boundary; 2: non-edge/sharp (boundary counts as non-edge)")
       ->check(CLI::IsMember({2, 3}))
       ->capture_default_str();
-  command->add_option("--scales", options->config.scales,
-                      "Neighbourhood sizes k, largest first; a power of two of them")
+  command
+      ->add_option("--scales", options->config.scales,
+                   "Neighbourhood sizes k, largest first; a power of two of them")
       ->delimiter(',')
       ->capture_default_str();
-  command->add_option("--exclude", options->exclude,
-                      "Skip files whose name contains PATTERN; repeat the flag for more patterns "
-                      "(--exclude a --exclude b), e.g. to keep evaluation twins out")
+  command
+      ->add_option("--exclude", options->exclude,
+                   "Skip files whose name contains PATTERN; repeat the flag for more patterns "
+                   "(--exclude a --exclude b), e.g. to keep evaluation twins out")
       ->allow_extra_args(false);
   command->add_option("--iterations", options->params.iterations, "Training iterations")
       ->check(CLI::NonNegativeNumber)
@@ -165,23 +169,28 @@ void register_edges_train(CLI::App& edges) {
   command->add_option("--lr", options->params.learning_rate, "Adam learning rate")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  command->add_option("--gamma", options->params.focal_gamma, "Focal-loss gamma (0 = cross-entropy)")
+  command
+      ->add_option("--gamma", options->params.focal_gamma, "Focal-loss gamma (0 = cross-entropy)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  command->add_option("--class-weights", options->params.class_weights,
-                      "Focal-loss alpha per class, comma-separated (default: none)")
+  command
+      ->add_option("--class-weights", options->params.class_weights,
+                   "Focal-loss alpha per class, comma-separated (default: none)")
       ->delimiter(',');
-  command->add_option("--validation", options->params.validation_fraction,
-                      "Fraction of each class held out for validation (0 = none, keep the last "
-                      "weights)")
+  command
+      ->add_option("--validation", options->params.validation_fraction,
+                   "Fraction of each class held out for validation (0 = none, keep the last "
+                   "weights)")
       ->check(CLI::Range(0.0, 0.99))
       ->capture_default_str();
-  command->add_option("--log-every", options->params.log_every,
-                      "Iterations between validation evaluations")
+  command
+      ->add_option("--log-every", options->params.log_every,
+                   "Iterations between validation evaluations")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  command->add_option("--seed", options->params.seed,
-                      "Seed of the initialisation, dropout, batches and validation split")
+  command
+      ->add_option("--seed", options->params.seed,
+                   "Seed of the initialisation, dropout, batches and validation split")
       ->capture_default_str();
   command->add_flag("--balance", options->params.balance_classes,
                     "Draw every batch with the classes in equal numbers (default off: uniform "

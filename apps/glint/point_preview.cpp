@@ -24,12 +24,12 @@ void write_point_preview(const std::string& path, const PointCloud& cloud,
   const double up[3] = {-std::sin(elevation) * std::sin(azimuth),
                         std::sin(elevation) * std::cos(azimuth), std::cos(elevation)};
   const double toward_viewer[3] = {std::cos(elevation) * std::sin(azimuth),
-                                   -std::cos(elevation) * std::cos(azimuth),
-                                   std::sin(elevation)};
+                                   -std::cos(elevation) * std::cos(azimuth), std::sin(elevation)};
   auto coordinates = [&](std::size_t i) {
     // Map y-up clouds into the z-up frame.
-    return params.up_axis == 'y' ? std::array<double, 3>{cloud.x[i], -double(cloud.z[i]), cloud.y[i]}
-                                 : std::array<double, 3>{cloud.x[i], cloud.y[i], cloud.z[i]};
+    return params.up_axis == 'y'
+               ? std::array<double, 3>{cloud.x[i], -double(cloud.z[i]), cloud.y[i]}
+               : std::array<double, 3>{cloud.x[i], cloud.y[i], cloud.z[i]};
   };
   std::vector<double> u(n), v(n), depth(n);
   double u_min = std::numeric_limits<double>::max(), u_max = -u_min, v_min = u_min, v_max = -u_min;

@@ -54,7 +54,8 @@ int main(int argc, char** argv) {
   const std::size_t points = std::stoull(arg_value(argc, argv, "--points", "1000000"));
   const std::string model_path = arg_value(argc, argv, "--model", "models/bounded-3c.json");
   const char* env_data = std::getenv("GLINT_DATA");
-  const std::string data_root = arg_value(argc, argv, "--data", env_data ? env_data : "../shared/data");
+  const std::string data_root =
+      arg_value(argc, argv, "--data", env_data ? env_data : "../shared/data");
   const std::string folder =
       arg_value(argc, argv, "--folder", data_root + "/pointclouds/default-eval");
   const std::string json_path = arg_value(argc, argv, "--json", "");
@@ -70,7 +71,8 @@ int main(int argc, char** argv) {
   const glint::PointCloud cloud = benchmark_cloud(points);
   const long rss_before_mib = peak_rss_mib();
   glint::Stopwatch watch;
-  const glint::edges::FeatureMatrix features = glint::edges::compute_features(cloud, feature_params);
+  const glint::edges::FeatureMatrix features =
+      glint::edges::compute_features(cloud, feature_params);
   const double features_s = watch.elapsed_s();
   watch.restart();
   std::vector<float> probabilities;

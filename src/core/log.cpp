@@ -19,7 +19,8 @@ spdlog::logger& log() {
 void set_log_level(const std::string& level) {
   const auto parsed = spdlog::level::from_str(level);
   if (parsed == spdlog::level::off && level != "off") {
-    throw Error("", "--log-level", "unknown level '" + level + "' (trace, debug, info, warn, error, off)");
+    throw Error("", "--log-level",
+                "unknown level '" + level + "' (trace, debug, info, warn, error, off)");
   }
   log().set_level(parsed);
 }

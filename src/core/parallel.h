@@ -22,10 +22,9 @@ void parallel_for(std::size_t n, Body&& body) {
 // use it when a chunk shares scratch memory or set-up work.
 template <class Body>
 void parallel_for_chunks(std::size_t n, std::size_t grain, Body&& body) {
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, grain),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      body(range.begin(), range.end());
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, n, grain),
+      [&](const tbb::blocked_range<std::size_t>& range) { body(range.begin(), range.end()); });
 }
 
 // Limits TBB to `threads` worker threads for the lifetime of the returned object (0 = all).

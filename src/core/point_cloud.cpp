@@ -76,8 +76,9 @@ std::vector<T> select_values(const std::vector<T>& values, const std::vector<boo
 
 PointCloud PointCloud::select(const std::vector<bool>& keep) const {
   if (keep.size() != size()) {
-    throw Error("", "selection mask", "has " + std::to_string(keep.size()) + " entries for " +
-                                          std::to_string(size()) + " points");
+    throw Error("", "selection mask",
+                "has " + std::to_string(keep.size()) + " entries for " + std::to_string(size()) +
+                    " points");
   }
   PointCloud out;
   out.x = select_values(x, keep);
@@ -86,8 +87,9 @@ PointCloud PointCloud::select(const std::vector<bool>& keep) const {
   for (const auto& attribute : attributes_) {
     out.attributes_.push_back(
         {attribute.name,
-         std::visit([&](const auto& values) { return AttributeColumn(select_values(values, keep)); },
-                    attribute.values)});
+         std::visit(
+             [&](const auto& values) { return AttributeColumn(select_values(values, keep)); },
+             attribute.values)});
   }
   return out;
 }

@@ -16,8 +16,8 @@ namespace glint {
 // One attribute column; the alternative held is the attribute's scalar type.
 using AttributeColumn =
     std::variant<std::vector<std::int8_t>, std::vector<std::uint8_t>, std::vector<std::int16_t>,
-                 std::vector<std::uint16_t>, std::vector<std::int32_t>,
-                 std::vector<std::uint32_t>, std::vector<float>, std::vector<double>>;
+                 std::vector<std::uint16_t>, std::vector<std::int32_t>, std::vector<std::uint32_t>,
+                 std::vector<float>, std::vector<double>>;
 
 struct NamedAttribute {
   std::string name;

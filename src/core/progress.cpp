@@ -20,7 +20,8 @@ ProgressBar::~ProgressBar() { finish(); }
 void ProgressBar::advance(std::size_t steps) {
   if (!enabled_) return;
   const std::size_t done = done_.fetch_add(steps) + steps;
-  const int permille = total_ == 0 ? 1000 : static_cast<int>(1000 * std::min(done, total_) / total_);
+  const int permille =
+      total_ == 0 ? 1000 : static_cast<int>(1000 * std::min(done, total_) / total_);
   // Redraw only when the shown value changes, so hot loops do not flood the terminal.
   int last = last_permille_.load();
   if (permille / 5 == last / 5 && last >= 0) return;

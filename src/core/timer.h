@@ -2,10 +2,9 @@
 // Wall-clock stopwatch and named per-stage timing statistics for reports.
 #include <chrono>
 #include <map>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json_fwd.hpp>
 
 namespace glint {
 

@@ -85,8 +85,8 @@ Moments moments_nearest_to(const geometry::Neighbourhood& nb, int k, const Vecto
   scratch.straddling.clear();
   for (int j = 0; j < k; ++j) {
     if (bucket_of[j] == cut) {
-      scratch.straddling.push_back(
-          (std::uint64_t(std::bit_cast<std::uint32_t>(d2[j])) << 32) | std::uint32_t(j));
+      scratch.straddling.push_back((std::uint64_t(std::bit_cast<std::uint32_t>(d2[j])) << 32) |
+                                   std::uint32_t(j));
     }
   }
   std::sort(scratch.straddling.begin(), scratch.straddling.end());
@@ -109,8 +109,8 @@ struct LargestScale {
 void scale_features(const geometry::Neighbourhood& nb, int k, const Moments& moments,
                     LargestScale& largest, Scratch& scratch, float* out) {
   std::fill(out, out + kFeaturesPerScale, 0.0f);
-  const Vector3d centre = moments.mean();                                           // eq. (5.3)
-  const Vector3d sigma = geometry::eigenvalues_descending(moments.covariance());    // eq. (5.2)
+  const Vector3d centre = moments.mean();                                         // eq. (5.3)
+  const Vector3d sigma = geometry::eigenvalues_descending(moments.covariance());  // eq. (5.2)
 
   const Moments core = moments_nearest_to(nb, k, centre, std::max(3, k / 2), scratch);
   Vector3d normal = geometry::smallest_eigenvector(core.covariance());
@@ -122,7 +122,7 @@ void scale_features(const geometry::Neighbourhood& nb, int k, const Moments& mom
 
   const double spread = std::sqrt(sigma[0]) + std::sqrt(sigma[1]);
   if (!(spread > 0) || !std::isfinite(spread)) return;  // all neighbours coincide
-  const double scale = 2.0 / spread;                      // eq. (5.4)
+  const double scale = 2.0 / spread;                    // eq. (5.4)
 
   // Upper / lower split, eqs. (5.5)-(5.6): <p - centre, n> >= 0. Only the upper moments are
   // summed (branch-free weight); lower = all - upper. Moments are gathered in the query frame
@@ -180,8 +180,9 @@ void check_scales(const std::vector<int>& scales) {
   if (scales.empty()) throw Error("", "scales", "at least one scale is needed");
   for (std::size_t s = 0; s < scales.size(); ++s) {
     if (scales[s] < 6) {
-      throw Error("", "scales", "scale " + std::to_string(scales[s]) +
-                                    " is too small (a neighbourhood needs at least 6 points)");
+      throw Error("", "scales",
+                  "scale " + std::to_string(scales[s]) +
+                      " is too small (a neighbourhood needs at least 6 points)");
     }
     if (s > 0 && scales[s] >= scales[s - 1]) {
       throw Error("", "scales", "scales must be strictly decreasing, largest first");
@@ -198,7 +199,8 @@ FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& par
   }
   if (cloud.size() < static_cast<std::size_t>(params.scales[0])) {
     throw Error("", "point cloud",
-                "has " + std::to_string(cloud.size()) + " points; the largest scale needs at least " +
+                "has " + std::to_string(cloud.size()) +
+                    " points; the largest scale needs at least " +
                     std::to_string(params.scales[0]));
   }
 

@@ -17,18 +17,24 @@ EvalTask parse_eval_task(const std::string& name) {
 
 std::string to_string(EvalTask task) {
   switch (task) {
-    case EvalTask::sharp: return "sharp";
-    case EvalTask::boundary: return "boundary";
-    case EvalTask::edge: return "edge";
+    case EvalTask::sharp:
+      return "sharp";
+    case EvalTask::boundary:
+      return "boundary";
+    case EvalTask::edge:
+      return "edge";
   }
   return "?";
 }
 
 bool is_positive(std::uint8_t label, EvalTask task) {
   switch (task) {
-    case EvalTask::sharp: return label == 1;
-    case EvalTask::boundary: return label == 2;
-    case EvalTask::edge: return label == 1 || label == 2;
+    case EvalTask::sharp:
+      return label == 1;
+    case EvalTask::boundary:
+      return label == 2;
+    case EvalTask::edge:
+      return label == 1 || label == 2;
   }
   return false;
 }
@@ -44,17 +50,21 @@ double ratio(double numerator, double denominator) {
 BinaryScores score(const std::vector<std::uint8_t>& predicted,
                    const std::vector<std::uint8_t>& truth, EvalTask task) {
   if (predicted.size() != truth.size()) {
-    throw Error("", "evaluation", "prediction has " + std::to_string(predicted.size()) +
-                                      " labels but ground truth has " +
-                                      std::to_string(truth.size()));
+    throw Error("", "evaluation",
+                "prediction has " + std::to_string(predicted.size()) +
+                    " labels but ground truth has " + std::to_string(truth.size()));
   }
   BinaryScores s;
   for (std::size_t i = 0; i < truth.size(); ++i) {
     const bool p = is_positive(predicted[i], task), t = is_positive(truth[i], task);
-    if (p && t) ++s.true_positives;
-    else if (p) ++s.false_positives;
-    else if (t) ++s.false_negatives;
-    else ++s.true_negatives;
+    if (p && t)
+      ++s.true_positives;
+    else if (p)
+      ++s.false_positives;
+    else if (t)
+      ++s.false_negatives;
+    else
+      ++s.true_negatives;
   }
   return scores_from_counts(s);
 }
@@ -77,10 +87,16 @@ BinaryScores scores_from_counts(BinaryScores s) {
 }
 
 nlohmann::json to_json(const BinaryScores& s) {
-  return {{"precision", s.precision}, {"recall", s.recall}, {"mcc", s.mcc},
-          {"f1", s.f1},               {"accuracy", s.accuracy}, {"iou", s.iou},
-          {"tp", s.true_positives},   {"fp", s.false_positives},
-          {"tn", s.true_negatives},   {"fn", s.false_negatives}};
+  return {{"precision", s.precision},
+          {"recall", s.recall},
+          {"mcc", s.mcc},
+          {"f1", s.f1},
+          {"accuracy", s.accuracy},
+          {"iou", s.iou},
+          {"tp", s.true_positives},
+          {"fp", s.false_positives},
+          {"tn", s.true_negatives},
+          {"fn", s.false_negatives}};
 }
 
 ScoreSummary summarise(const std::vector<BinaryScores>& per_file) {

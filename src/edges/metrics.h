@@ -3,10 +3,9 @@
 // class taken as "positive" against everything else.
 #include <cstddef>
 #include <cstdint>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json_fwd.hpp>
 
 namespace glint::edges {
 

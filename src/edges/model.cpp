@@ -113,7 +113,9 @@ class FileReader {
 
 // A float as the double closest to its 9-significant-digit decimal: the JSON writer prints it
 // with at most 9 digits, and reading it back gives the same float.
-double nine_digits(float value) { return std::strtod(fmt::format("{:.9g}", value).c_str(), nullptr); }
+double nine_digits(float value) {
+  return std::strtod(fmt::format("{:.9g}", value).c_str(), nullptr);
+}
 
 nlohmann::json float_array(const std::vector<float>& values) {
   nlohmann::json array = nlohmann::json::array();
@@ -137,11 +139,9 @@ void check_config(const ModelConfig& config) {
   if (config.hidden < 1)
     throw Error(where, "hidden", fmt::format("must be >= 1, got {}", config.hidden));
   if (config.hidden_layers < 0)
-    throw Error(where, "hidden_layers",
-                fmt::format("must be >= 0, got {}", config.hidden_layers));
+    throw Error(where, "hidden_layers", fmt::format("must be >= 0, got {}", config.hidden_layers));
   if (!std::isfinite(config.leaky_slope) || config.leaky_slope < 0.0f || config.leaky_slope >= 1.0f)
-    throw Error(where, "leaky_slope",
-                fmt::format("must be in [0, 1), got {}", config.leaky_slope));
+    throw Error(where, "leaky_slope", fmt::format("must be in [0, 1), got {}", config.leaky_slope));
 }
 
 std::vector<DenseLayer> make_layers(const ModelConfig& config) {
@@ -195,16 +195,17 @@ void Model::check() const {
       throw Error(where, "input_std", fmt::format("values must be >= {}", kMinInputStd));
   const std::vector<DenseLayer> expected = make_layers(config);
   if (layers.size() != expected.size())
-    throw Error(where, "layers",
-                fmt::format("the config implies {} layers, have {}", expected.size(), layers.size()));
+    throw Error(
+        where, "layers",
+        fmt::format("the config implies {} layers, have {}", expected.size(), layers.size()));
   for (std::size_t l = 0; l < layers.size(); ++l) {
     const DenseLayer& layer = layers[l];
     const DenseLayer& shape = expected[l];
     if (layer.inputs != shape.inputs || layer.outputs != shape.outputs ||
         layer.weights.size() != shape.weights.size() || layer.bias.size() != shape.bias.size())
       throw Error(where, shape.name,
-                  fmt::format("expected {} x {} weights and {} biases", shape.outputs,
-                              shape.inputs, shape.outputs));
+                  fmt::format("expected {} x {} weights and {} biases", shape.outputs, shape.inputs,
+                              shape.outputs));
   }
 }
 
@@ -259,9 +260,11 @@ Model Model::load(const std::string& path) {
     reader.fail("classes", "expected a list of 2 or 3 class names");
   const int class_count = static_cast<int>(classes.size());
   if (classes != nlohmann::json(class_names(class_count)))
-    reader.fail("classes", fmt::format("expected {}", nlohmann::json(class_names(class_count)).dump()));
+    reader.fail("classes",
+                fmt::format("expected {}", nlohmann::json(class_names(class_count)).dump()));
 
-  if (const int features = reader.integer(root, "features_per_scale"); features != kFeaturesPerScale)
+  if (const int features = reader.integer(root, "features_per_scale");
+      features != kFeaturesPerScale)
     reader.fail("features_per_scale",
                 fmt::format("expected {}, got {}", kFeaturesPerScale, features));
 
@@ -271,8 +274,8 @@ Model Model::load(const std::string& path) {
   config.fusion_width = reader.integer(root, "fusion_width");
   config.hidden = reader.integer(root, "hidden");
   config.hidden_layers = reader.integer(root, "hidden_layers");
-  config.leaky_slope = reader.finite_float(reader.member(root, "leaky_slope", "leaky_slope"),
-                                           "leaky_slope");
+  config.leaky_slope =
+      reader.finite_float(reader.member(root, "leaky_slope", "leaky_slope"), "leaky_slope");
   try {
     check_config(config);
   } catch (const Error& e) {
@@ -301,8 +304,8 @@ Model Model::load(const std::string& path) {
     const nlohmann::json& inputs = reader.member(entry, "inputs", where + ".inputs");
     const nlohmann::json& outputs = reader.member(entry, "outputs", where + ".outputs");
     if (inputs != layer.inputs || outputs != layer.outputs)
-      reader.fail(where, fmt::format("the config implies a {} x {} layer", layer.outputs,
-                                     layer.inputs));
+      reader.fail(where,
+                  fmt::format("the config implies a {} x {} layer", layer.outputs, layer.inputs));
     layer.weights = reader.floats(entry, "weights", layer.weights.size(), where + ".weights");
     layer.bias = reader.floats(entry, "bias", layer.bias.size(), where + ".bias");
   }
@@ -322,9 +325,9 @@ Model Model::load(const std::string& path) {
 void Model::check_features(const FeatureMatrix& features) const {
   const int scales = static_cast<int>(config.scales.size());
   if (features.scales != scales)
-    throw Error("features", "scales",
-                fmt::format("the model expects {} scales, the features have {}", scales,
-                            features.scales));
+    throw Error(
+        "features", "scales",
+        fmt::format("the model expects {} scales, the features have {}", scales, features.scales));
   if (features.values.size() != features.points * features.row_size())
     throw Error("features", "values",
                 fmt::format("expected {} values for {} points, have {}",

@@ -15,22 +15,21 @@
 // Classes: index = glint point label: 0 non-edge, 1 sharp edge, 2 boundary (C = 3 only).
 #include <cstddef>
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "edges/features.h"
 
 namespace glint::edges {
 
 struct ModelConfig {
-  int classes = 3;                         // 3: non-edge/sharp/boundary; 2: non-edge/sharp
+  int classes = 3;                           // 3: non-edge/sharp/boundary; 2: non-edge/sharp
   std::vector<int> scales{128, 64, 32, 16};  // k of each feature scale, as given to the features
-  int fusion_width = 12;                   // outputs of every fusion node
-  int hidden = 16;                         // width of each hidden head layer
-  int hidden_layers = 3;                   // number of hidden head layers
-  float leaky_slope = 0.01f;               // LeakyReLU negative slope
+  int fusion_width = 12;                     // outputs of every fusion node
+  int hidden = 16;                           // width of each hidden head layer
+  int hidden_layers = 3;                     // number of hidden head layers
+  float leaky_slope = 0.01f;                 // LeakyReLU negative slope
 };
 
 // Throws glint::Error when a config cannot describe a network: classes not 2 or 3, scale
@@ -40,11 +39,11 @@ void check_config(const ModelConfig& config);
 
 // One fully connected layer: output = weights * input + bias.
 struct DenseLayer {
-  std::string name;             // "fusion<level>.<node>", "hidden<i>" or "output"
+  std::string name;  // "fusion<level>.<node>", "hidden<i>" or "output"
   int inputs = 0;
   int outputs = 0;
-  std::vector<float> weights;   // outputs x inputs, row-major (the layout of torch's nn::Linear)
-  std::vector<float> bias;      // outputs
+  std::vector<float> weights;  // outputs x inputs, row-major (the layout of torch's nn::Linear)
+  std::vector<float> bias;     // outputs
 };
 
 // The dense layers a config implies, in evaluation order (fusion level by level, node by node;
@@ -58,8 +57,8 @@ class Model {
   explicit Model(ModelConfig config = {});
 
   ModelConfig config;
-  std::vector<float> input_mean;  // S*F, column order of FeatureMatrix rows
-  std::vector<float> input_std;   // S*F, each >= kMinInputStd
+  std::vector<float> input_mean;   // S*F, column order of FeatureMatrix rows
+  std::vector<float> input_std;    // S*F, each >= kMinInputStd
   std::vector<DenseLayer> layers;  // see make_layers
   nlohmann::json training_info = nlohmann::json::object();  // free-form: how it was trained
 

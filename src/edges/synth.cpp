@@ -127,8 +127,10 @@ std::set<std::array<int, 3>> fractal_voxels(Rng& rng) {
         occupied_neighbours += static_cast<int>(voxels.count(n));
       }
     // Bumps grow from a face; notches are cut where the voxel is exposed.
-    if (!voxels.count(cell) && occupied_neighbours > 0) voxels.insert(cell);
-    else if (voxels.count(cell) && occupied_neighbours < 6 && voxels.size() > 1) voxels.erase(cell);
+    if (!voxels.count(cell) && occupied_neighbours > 0)
+      voxels.insert(cell);
+    else if (voxels.count(cell) && occupied_neighbours < 6 && voxels.size() > 1)
+      voxels.erase(cell);
   }
   return voxels;
 }
@@ -154,7 +156,8 @@ void add_holed_tiles(Mesh& mesh, Rng& rng) {
       add_surface(mesh, 4 * kPerSide, 2, [&](double u, double v) -> Vec {
         const double angle = kPi / 4.0 + 2.0 * kPi * u;
         const Vec direction(std::cos(angle), std::sin(angle), 0.0);
-        const Vec square = 0.5 * direction / std::max(std::abs(direction.x()), std::abs(direction.y()));
+        const Vec square =
+            0.5 * direction / std::max(std::abs(direction.x()), std::abs(direction.y()));
         return centre + radius * direction + v * (square - radius * direction);
       });
     }
@@ -216,7 +219,8 @@ Shape build_shape(SynthShape kind, Rng& rng, int points, double sharp_angle) {
       add_surface(mesh, kCircleSegments, 1,
                   [&](double u, double v) { return ring(r0 + (r1 - r0) * v, u, height * v); });
       if (kind != SynthShape::tube) add_disc(mesh, 0.0, r0, 0.0);
-      if (kind == SynthShape::cylinder || kind == SynthShape::frustum) add_disc(mesh, 0.0, r1, height);
+      if (kind == SynthShape::cylinder || kind == SynthShape::frustum)
+        add_disc(mesh, 0.0, r1, height);
       p["radii"] = {r0, r1};
       p["height"] = height;
       break;
@@ -231,7 +235,8 @@ Shape build_shape(SynthShape kind, Rng& rng, int points, double sharp_angle) {
       const double amplitude = uniform(rng, 0.02, 0.06), fu = uniform(rng, 0.5, 1.5),
                    fv = uniform(rng, 0.5, 1.5), phase = uniform(rng, 0.0, 2.0 * kPi);
       add_surface(mesh, 96, 96, [&](double u, double v) {
-        return Vec(u, v, amplitude * std::sin(2 * kPi * fu * u + phase) * std::cos(2 * kPi * fv * v));
+        return Vec(u, v,
+                   amplitude * std::sin(2 * kPi * fu * u + phase) * std::cos(2 * kPi * fv * v));
       });
       p["amplitude"] = amplitude;
       break;
@@ -259,7 +264,8 @@ Shape build_shape(SynthShape kind, Rng& rng, int points, double sharp_angle) {
     }
     case SynthShape::curved_sheet: {
       const double arc = uniform(rng, 60.0, 300.0), height = uniform(rng, 0.3, 1.5);
-      add_surface(mesh, 64, 1, [&](double u, double v) { return ring(0.5, u * arc / 360.0, height * v); });
+      add_surface(mesh, 64, 1,
+                  [&](double u, double v) { return ring(0.5, u * arc / 360.0, height * v); });
       p["arc_degrees"] = arc;
       break;
     }
@@ -282,7 +288,8 @@ void weld(Mesh& mesh) {
   std::vector<int> remap(mesh.vertices.size());
   for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
     const Vec& v = mesh.vertices[i];
-    const std::array<std::int64_t, 3> key{std::llround(v.x() / quantum), std::llround(v.y() / quantum),
+    const std::array<std::int64_t, 3> key{std::llround(v.x() / quantum),
+                                          std::llround(v.y() / quantum),
                                           std::llround(v.z() / quantum)};
     const auto [it, inserted] = index.emplace(key, static_cast<int>(vertices.size()));
     if (inserted) vertices.push_back(v);
@@ -320,7 +327,8 @@ std::vector<FeatureSegment> feature_edges(const Mesh& mesh, double sharp_angle_d
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
     for (int c = 0; c < 3; ++c) {
       const int from = mesh.triangles[t][c], to = mesh.triangles[t][(c + 1) % 3];
-      const auto key = (std::uint64_t(std::min(from, to)) << 32) | std::uint32_t(std::max(from, to));
+      const auto key =
+          (std::uint64_t(std::min(from, to)) << 32) | std::uint32_t(std::max(from, to));
       edges[key].push_back({static_cast<int>(t), from < to});
     }
   const double cos_sharp = std::cos(sharp_angle_deg * kPi / 180.0);
@@ -343,8 +351,8 @@ std::vector<FeatureSegment> feature_edges(const Mesh& mesh, double sharp_angle_d
   // The hash map's order depends on the library: sort for reproducible clouds.
   std::sort(segments.begin(), segments.end(), [](const FeatureSegment& l, const FeatureSegment& r) {
     return std::lexicographical_compare(l.a.data(), l.a.data() + 3, r.a.data(), r.a.data() + 3) ||
-           (l.a == r.a && std::lexicographical_compare(l.b.data(), l.b.data() + 3, r.b.data(),
-                                                       r.b.data() + 3));
+           (l.a == r.a &&
+            std::lexicographical_compare(l.b.data(), l.b.data() + 3, r.b.data(), r.b.data() + 3));
   });
   return segments;
 }
@@ -360,7 +368,8 @@ double segment_distance(const Vec& p, const Vec& a, const Vec& b) {
 // their midpoints on a grid whose cell covers band + half a piece, so 27 cells always suffice.
 class FeatureIndex {
  public:
-  FeatureIndex(const std::vector<FeatureSegment>& segments, double max_band) : cell_(2.0 * max_band) {
+  FeatureIndex(const std::vector<FeatureSegment>& segments, double max_band)
+      : cell_(2.0 * max_band) {
     for (const FeatureSegment& s : segments) {
       const int pieces = std::max(1, static_cast<int>(std::ceil((s.b - s.a).norm() / max_band)));
       for (int i = 0; i < pieces; ++i) {
@@ -381,8 +390,8 @@ class FeatureIndex {
           const auto it = cells_.find(pack({centre[0] + dx, centre[1] + dy, centre[2] + dz}));
           if (it == cells_.end()) continue;
           for (const FeatureSegment& s : it->second)
-            if (s.label > result &&
-                segment_distance(p, s.a, s.b) <= (s.label == kBoundary ? boundary_band : sharp_band))
+            if (s.label > result && segment_distance(p, s.a, s.b) <=
+                                        (s.label == kBoundary ? boundary_band : sharp_band))
               result = s.label;
         }
     return result;
@@ -429,8 +438,8 @@ std::uint64_t splitmix64(std::uint64_t x) {
 
 const std::vector<std::string>& synth_shape_names() {
   static const std::vector<std::string> names{
-      "crease",   "bend",     "box",  "open_box",   "thin_wall", "fractal_cube", "stairs",
-      "cylinder", "tube",     "cone", "frustum",    "sheet",     "wavy_sheet",   "disc",
+      "crease",   "bend",        "box",    "open_box",   "thin_wall",   "fractal_cube", "stairs",
+      "cylinder", "tube",        "cone",   "frustum",    "sheet",       "wavy_sheet",   "disc",
       "annulus",  "holed_sheet", "sphere", "hemisphere", "curved_sheet"};
   return names;
 }
@@ -446,10 +455,12 @@ SynthShape parse_synth_shape(const std::string& name) {
 void check_synth_params(const SynthParams& p) {
   const std::string where = "synth parameters";
   if (p.min_points < 200 || p.max_points < p.min_points)
-    throw Error(where, "points", fmt::format("need 200 <= min ({}) <= max ({})", p.min_points, p.max_points));
+    throw Error(where, "points",
+                fmt::format("need 200 <= min ({}) <= max ({})", p.min_points, p.max_points));
   if (p.noise_levels.empty()) throw Error(where, "noise", "give at least one noise level");
   for (double level : p.noise_levels)
-    if (!(level >= 0.0 && level <= 5.0)) throw Error(where, "noise", "levels must be in [0, 5] spacings");
+    if (!(level >= 0.0 && level <= 5.0))
+      throw Error(where, "noise", "levels must be in [0, 5] spacings");
   for (double probability : {p.outlier_probability, p.abc_probability, p.gradient_probability})
     if (!(probability >= 0.0 && probability <= 1.0))
       throw Error(where, "probability", "probabilities must be in [0, 1]");
@@ -491,14 +502,18 @@ SynthCloud synthesize_cloud(const SynthParams& params, std::uint64_t index) {
   const bool has_gradient = chance(rng, params.gradient_probability);
   const double gradient = has_gradient ? uniform(rng, 0.3, 0.8) : 0.0;
   const Vec gradient_direction = random_rotation(rng).col(0);
-  auto weight = [&](const Vec& p) { return 1.0 + gradient * std::clamp(2.0 * p.dot(gradient_direction), -1.0, 1.0); };
+  auto weight = [&](const Vec& p) {
+    return 1.0 + gradient * std::clamp(2.0 * p.dot(gradient_direction), -1.0, 1.0);
+  };
   auto local_spacing = [&](const Vec& p) { return spacing / std::sqrt(weight(p)); };
   const FeatureIndex index_of_features(
       features, std::max(params.band, params.boundary_band) * spacing / std::sqrt(1.0 - gradient));
 
   const bool abc = chance(rng, params.abc_probability);
-  const double noise = params.noise_levels[uniform_int(rng, 0, int(params.noise_levels.size()) - 1)];
-  const double outlier_share = chance(rng, params.outlier_probability) ? uniform(rng, 0.02, 0.15) : 0.0;
+  const double noise =
+      params.noise_levels[uniform_int(rng, 0, int(params.noise_levels.size()) - 1)];
+  const double outlier_share =
+      chance(rng, params.outlier_probability) ? uniform(rng, 0.02, 0.15) : 0.0;
 
   std::vector<Vec> positions;
   positions.reserve(points);
@@ -513,8 +528,9 @@ SynthCloud synthesize_cloud(const SynthParams& params, std::uint64_t index) {
   }
   while (positions.size() < std::size_t(points)) {
     const double pick = uniform(rng, 0.0, area);
-    const auto t = mesh.triangles[std::lower_bound(cumulative_area.begin(), cumulative_area.end(), pick) -
-                                  cumulative_area.begin()];
+    const auto t =
+        mesh.triangles[std::lower_bound(cumulative_area.begin(), cumulative_area.end(), pick) -
+                       cumulative_area.begin()];
     double r1 = uniform(rng, 0.0, 1.0), r2 = uniform(rng, 0.0, 1.0);
     if (r1 + r2 > 1.0) r1 = 1.0 - r1, r2 = 1.0 - r2;
     const Vec p = mesh.vertices[t[0]] + r1 * (mesh.vertices[t[1]] - mesh.vertices[t[0]]) +
@@ -550,16 +566,17 @@ SynthCloud synthesize_cloud(const SynthParams& params, std::uint64_t index) {
 
   SynthCloud result;
   result.cloud = std::move(cloud);
-  result.description = {{"index", index},
-                        {"shape", all_names[static_cast<std::size_t>(kind)]},
-                        {"shape_parameters", shape.parameters},
-                        {"points", positions.size()},
-                        {"spacing", spacing},
-                        {"sampling", abc ? "abc" : "uniform"},
-                        {"density_gradient", gradient},
-                        {"noise_spacings", noise},
-                        {"outliers", outliers},
-                        {"labels", {{"non-edge", counts[0]}, {"sharp-edge", counts[1]}, {"boundary", counts[2]}}}};
+  result.description = {
+      {"index", index},
+      {"shape", all_names[static_cast<std::size_t>(kind)]},
+      {"shape_parameters", shape.parameters},
+      {"points", positions.size()},
+      {"spacing", spacing},
+      {"sampling", abc ? "abc" : "uniform"},
+      {"density_gradient", gradient},
+      {"noise_spacings", noise},
+      {"outliers", outliers},
+      {"labels", {{"non-edge", counts[0]}, {"sharp-edge", counts[1]}, {"boundary", counts[2]}}}};
   return result;
 }
 

@@ -25,8 +25,8 @@ class BoundedNetImpl : public torch::nn::Module {
     input_std_ = register_buffer("input_std", torch::ones({columns}));
     const std::vector<DenseLayer> shapes = make_layers(config);
     for (std::size_t l = 0; l < shapes.size(); ++l)
-      linears_.push_back(register_module(
-          fmt::format("layer{}", l), torch::nn::Linear(shapes[l].inputs, shapes[l].outputs)));
+      linears_.push_back(register_module(fmt::format("layer{}", l),
+                                         torch::nn::Linear(shapes[l].inputs, shapes[l].outputs)));
     dropout_ = register_module("dropout", torch::nn::Dropout(dropout));
   }
 
@@ -41,7 +41,8 @@ class BoundedNetImpl : public torch::nn::Module {
          vectors /= 2, width = config_.fusion_width) {
       std::vector<torch::Tensor> fused;
       for (int node = 0; node < vectors / 2; ++node)
-        fused.push_back(leaky(linears_[layer++]->forward(x.narrow(1, 2 * node * width, 2 * width))));
+        fused.push_back(
+            leaky(linears_[layer++]->forward(x.narrow(1, 2 * node * width, 2 * width))));
       x = torch::cat(fused, 1);
     }
     for (int h = 0; h < config_.hidden_layers; ++h)
@@ -106,10 +107,10 @@ torch::Tensor focal_loss(const torch::Tensor& logits, const torch::Tensor& targe
 
 // A view of the feature values as a points x columns tensor (no copy; never written to).
 torch::Tensor feature_tensor(const FeatureMatrix& features) {
-  return torch::from_blob(const_cast<float*>(features.values.data()),
-                          {static_cast<std::int64_t>(features.points),
-                           static_cast<std::int64_t>(features.row_size())},
-                          torch::kFloat32);
+  return torch::from_blob(
+      const_cast<float*>(features.values.data()),
+      {static_cast<std::int64_t>(features.points), static_cast<std::int64_t>(features.row_size())},
+      torch::kFloat32);
 }
 
 torch::Tensor index_tensor(const std::vector<std::int64_t>& indices) {
@@ -141,7 +142,7 @@ void check_params(const TrainParams& params, int classes) {
 
 // Training and validation points per class, the validation part a stratified random sample.
 struct Split {
-  std::vector<std::vector<std::int64_t>> training;    // per class
+  std::vector<std::vector<std::int64_t>> training;  // per class
   std::vector<std::int64_t> training_all;
   std::vector<std::int64_t> validation;
 };
@@ -159,8 +160,8 @@ Split split_points(const std::vector<std::uint8_t>& labels, int classes, double 
     // At least one validation point per present class, at least one training point kept.
     std::size_t held_out = 0;
     if (fraction > 0.0 && points.size() >= 2)
-      held_out = std::clamp<std::size_t>(std::llround(fraction * points.size()), 1,
-                                         points.size() - 1);
+      held_out =
+          std::clamp<std::size_t>(std::llround(fraction * points.size()), 1, points.size() - 1);
     split.validation.insert(split.validation.end(), points.begin(), points.begin() + held_out);
     split.training[c].assign(points.begin() + held_out, points.end());
     std::sort(split.training[c].begin(), split.training[c].end());
@@ -256,7 +257,8 @@ double tune_non_edge_offset(BoundedNet& net, const torch::Tensor& features,
     shifted.select(1, 0) += offset;
     const double f1 = mean_edge_f1(shifted.argmax(1), targets, classes);
     if (step == 0) f1_at_zero = f1;
-    if (f1 > best_f1 + 1e-12 || (std::abs(f1 - best_f1) <= 1e-12 && std::abs(offset) < std::abs(best_offset))) {
+    if (f1 > best_f1 + 1e-12 ||
+        (std::abs(f1 - best_f1) <= 1e-12 && std::abs(offset) < std::abs(best_offset))) {
       best_f1 = f1;
       best_offset = offset;
     }
@@ -269,7 +271,8 @@ double tune_non_edge_offset(BoundedNet& net, const torch::Tensor& features,
 
 nlohmann::json recall_json(const std::vector<double>& recall) {
   nlohmann::json array = nlohmann::json::array();
-  for (double r : recall) array.push_back(std::isnan(r) ? nlohmann::json(nullptr) : nlohmann::json(r));
+  for (double r : recall)
+    array.push_back(std::isnan(r) ? nlohmann::json(nullptr) : nlohmann::json(r));
   return array;
 }
 
@@ -285,9 +288,9 @@ Model train_model(const TrainingSet& data, const ModelConfig& config, const Trai
                 fmt::format("{} labels for {} points", data.labels.size(), data.features.points));
   for (std::size_t i = 0; i < data.labels.size(); ++i)
     if (data.labels[i] >= config.classes)
-      throw Error("training data", fmt::format("label of point {}", i),
-                  fmt::format("{} is not a class of a {}-class model", data.labels[i],
-                              config.classes));
+      throw Error(
+          "training data", fmt::format("label of point {}", i),
+          fmt::format("{} is not a class of a {}-class model", data.labels[i], config.classes));
 
   const Stopwatch watch;
   const auto threads = static_cast<int>(
@@ -368,15 +371,17 @@ Model train_model(const TrainingSet& data, const ModelConfig& config, const Trai
       entry["validation_loss"] = validation.loss;
       entry["validation_accuracy"] = validation.accuracy;
       entry["validation_recall"] = recall_json(validation.recall);
-      log().info("iteration {}/{}: training loss {:.5f}, validation loss {:.5f}, accuracy "
-                 "{:.4f}, recall per class {}",
-                 iteration, params.iterations, last_train_loss, validation.loss,
-                 validation.accuracy, recall_json(validation.recall).dump());
+      log().info(
+          "iteration {}/{}: training loss {:.5f}, validation loss {:.5f}, accuracy "
+          "{:.4f}, recall per class {}",
+          iteration, params.iterations, last_train_loss, validation.loss, validation.accuracy,
+          recall_json(validation.recall).dump());
       if (validation.loss < best.loss) {
         best = validation;
         best_iteration = iteration;
         best_parameters.clear();
-        for (const torch::Tensor& p : net->parameters()) best_parameters.push_back(p.detach().clone());
+        for (const torch::Tensor& p : net->parameters())
+          best_parameters.push_back(p.detach().clone());
       }
     }
     history.push_back(entry);
@@ -392,8 +397,8 @@ Model train_model(const TrainingSet& data, const ModelConfig& config, const Trai
   }
   nlohmann::json threshold = nullptr;
   if (params.tune_threshold && !split.validation.empty()) {
-    const double offset = tune_non_edge_offset(net, features, labels, split.validation,
-                                               config.classes, threshold);
+    const double offset =
+        tune_non_edge_offset(net, features, labels, split.validation, config.classes, threshold);
     net->shift_non_edge_logit(offset);
     log().info("non-edge logit offset {:+.1f}: mean edge F1 on validation {:.4f} (without: {:.4f})",
                offset, threshold["validation_edge_f1"].get<double>(),
@@ -410,25 +415,24 @@ Model train_model(const TrainingSet& data, const ModelConfig& config, const Trai
                          {"validation_loss", best.loss},
                          {"validation_accuracy", best.accuracy},
                          {"validation_recall", recall_json(best.recall)}});
-  model.training_info = {
-      {"iterations", params.iterations},
-      {"batch_size", params.batch_size},
-      {"learning_rate", params.learning_rate},
-      {"optimiser", "Adam(beta1 0.9, beta2 0.999)"},
-      {"loss", "focal"},
-      {"focal_gamma", params.focal_gamma},
-      {"class_weights", params.class_weights},
-      {"dropout", params.dropout},
-      {"seed", params.seed},
-      {"balance_classes", params.balance_classes},
-      {"threshold_tuning", threshold},
-      {"validation_fraction", params.validation_fraction},
-      {"threads", threads},
-      {"training_points_per_class", training_counts},
-      {"validation_points_per_class", validation_counts},
-      {"history", history},
-      {"final", final_losses},
-      {"seconds", watch.elapsed_s()}};
+  model.training_info = {{"iterations", params.iterations},
+                         {"batch_size", params.batch_size},
+                         {"learning_rate", params.learning_rate},
+                         {"optimiser", "Adam(beta1 0.9, beta2 0.999)"},
+                         {"loss", "focal"},
+                         {"focal_gamma", params.focal_gamma},
+                         {"class_weights", params.class_weights},
+                         {"dropout", params.dropout},
+                         {"seed", params.seed},
+                         {"balance_classes", params.balance_classes},
+                         {"threshold_tuning", threshold},
+                         {"validation_fraction", params.validation_fraction},
+                         {"threads", threads},
+                         {"training_points_per_class", training_counts},
+                         {"validation_points_per_class", validation_counts},
+                         {"history", history},
+                         {"final", final_losses},
+                         {"seconds", watch.elapsed_s()}};
   return model;
 }
 

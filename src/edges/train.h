@@ -22,15 +22,15 @@
 namespace glint::edges {
 
 struct TrainParams {
-  int iterations = 3000;           // thesis: 3000 on Default/Default++, 8000 on ABC
-  int batch_size = 16384;          // points per iteration
+  int iterations = 3000;   // thesis: 3000 on Default/Default++, 8000 on ABC
+  int batch_size = 16384;  // points per iteration
   double learning_rate = 1e-3;
   double focal_gamma = 2.0;
   std::vector<double> class_weights;  // focal alpha per class; empty = all 1
-  double dropout = 0.5;            // in the classification layers
+  double dropout = 0.5;               // in the classification layers
   std::uint64_t seed = 1;
   double validation_fraction = 0.05;  // of each class's points; 0 = no validation split
-  int log_every = 100;             // iterations between validation evaluations / log lines
+  int log_every = 100;                // iterations between validation evaluations / log lines
   // false: batches drawn uniformly from all training points (the thesis; the focal loss copes
   // with the imbalance). true: every batch holds the classes in equal numbers.
   bool balance_classes = false;

@@ -61,9 +61,9 @@ Eigen::Vector3d smallest_eigenvector(const SymmetricMatrix3& m) {
     if (row.squaredNorm() > strongest->squaredNorm()) strongest = &row;
   }
   if (strongest->squaredNorm() == 0) return Eigen::Vector3d::UnitZ();
-  const Eigen::Vector3d helper =
-      std::abs(strongest->x()) < 0.9 * strongest->norm() ? Eigen::Vector3d::UnitX()
-                                                         : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d helper = std::abs(strongest->x()) < 0.9 * strongest->norm()
+                                     ? Eigen::Vector3d::UnitX()
+                                     : Eigen::Vector3d::UnitY();
   return strongest->cross(helper).normalized();
 }
 

@@ -29,8 +29,7 @@ using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<fl
 
 struct KdTree::Index {
   Index(const PointCloud& cloud, int max_leaf_size)
-      : adaptor{cloud},
-        tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(max_leaf_size)) {
+      : adaptor{cloud}, tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(max_leaf_size)) {
     tree.buildIndex();
   }
   CloudAdaptor adaptor;

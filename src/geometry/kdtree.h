@@ -28,7 +28,8 @@ class KdTree {
   // belongs to the cloud). Returns the number found; outputs must hold k entries.
   int knn(const float query[3], int k, std::uint32_t* indices, float* squared_distances) const;
 
-  // k nearest neighbours of every cloud point, in parallel. Needs k <= size (glint::Error otherwise).
+  // k nearest neighbours of every cloud point, in parallel. Needs k <= size (glint::Error
+  // otherwise).
   KnnResult knn_all(int k) const;
 
   std::size_t size() const;

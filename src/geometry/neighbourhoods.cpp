@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <array>
-#include <utility>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -13,6 +12,7 @@
 #include <numeric>
 #include <random>
 #include <string>
+#include <utility>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -37,11 +37,11 @@ struct Grid {
   double cell = 1.0;
   double origin[3] = {0, 0, 0};
   std::int64_t dims[3] = {1, 1, 1};
-  std::vector<std::uint32_t> cell_begin;   // cells + 1 offsets into the sorted arrays
-  std::vector<std::int32_t> cell_coords;   // 3 per cell
-  std::vector<std::int32_t> cell_z;        // z index per cell (binary search within a column)
-  std::vector<float> xs, ys, zs;           // positions in cell order
-  std::vector<std::uint32_t> original;     // cloud index of each sorted slot
+  std::vector<std::uint32_t> cell_begin;  // cells + 1 offsets into the sorted arrays
+  std::vector<std::int32_t> cell_coords;  // 3 per cell
+  std::vector<std::int32_t> cell_z;       // z index per cell (binary search within a column)
+  std::vector<float> xs, ys, zs;          // positions in cell order
+  std::vector<std::uint32_t> original;    // cloud index of each sorted slot
   // Open-addressing hash: column key -> its first cell and one past its last.
   std::vector<std::uint64_t> table_keys;
   std::vector<std::uint32_t> table_first, table_end;
@@ -125,8 +125,8 @@ Grid build_grid(const PointCloud& cloud, double cell_size) {
     lo[a] = *min_it;
     hi[a] = *max_it;
   }
-  const double extent = std::max({double(hi[0]) - lo[0], double(hi[1]) - lo[1],
-                                  double(hi[2]) - lo[2]});
+  const double extent =
+      std::max({double(hi[0]) - lo[0], double(hi[1]) - lo[1], double(hi[2]) - lo[2]});
   if (!(cell_size > 0.0) || !std::isfinite(cell_size)) cell_size = extent > 0 ? extent : 1.0;
   // Keep the key space inside 64 bits: at most 2^20 cells per axis.
   cell_size = std::max(cell_size, extent / double(1 << 20));
@@ -180,7 +180,8 @@ Grid build_grid(const PointCloud& cloud, double cell_size) {
   grid.table_first.assign(capacity, 0);
   grid.table_end.assign(capacity, 0);
   for (std::size_t c = 0; c < cells;) {
-    const std::uint64_t column = grid.column_key(grid.cell_coords[3 * c], grid.cell_coords[3 * c + 1]);
+    const std::uint64_t column =
+        grid.column_key(grid.cell_coords[3 * c], grid.cell_coords[3 * c + 1]);
     std::size_t end = c + 1;
     while (end < cells &&
            grid.column_key(grid.cell_coords[3 * end], grid.cell_coords[3 * end + 1]) == column) {
@@ -198,25 +199,25 @@ Grid build_grid(const PointCloud& cloud, double cell_size) {
 
 // Per-thread working memory, reused across cells (no allocation per point).
 struct Scratch {
-  std::vector<float> cx, cy, cz;        // gathered candidates
-  std::vector<std::uint32_t> cslot;     // their sorted-slot index
-  std::vector<float> distances;         // squared distance of each candidate to the query
-  std::vector<std::uint64_t> ranked;    // (squared distance bits << 32) | candidate
-  float previous_kth = 0;               // k-th squared distance of the previous query
+  std::vector<float> cx, cy, cz;      // gathered candidates
+  std::vector<std::uint32_t> cslot;   // their sorted-slot index
+  std::vector<float> distances;       // squared distance of each candidate to the query
+  std::vector<std::uint64_t> ranked;  // (squared distance bits << 32) | candidate
+  float previous_kth = 0;             // k-th squared distance of the previous query
   static constexpr int kBuckets = 256;
   std::vector<std::uint32_t> within;     // candidates inside the bucket range
   std::vector<std::uint16_t> bucket_of;  // bucket of each of them
   std::array<std::uint32_t, kBuckets> bucket_start{};
-  std::vector<float> dx, dy, dz;        // accepted neighbourhood, relative to the query
+  std::vector<float> dx, dy, dz;  // accepted neighbourhood, relative to the query
   std::vector<std::uint32_t> indices;
-  std::vector<std::uint32_t> retry;     // sorted slots that need a larger block
+  std::vector<std::uint32_t> retry;  // sorted slots that need a larger block
   std::vector<float> fallback_distances;
 };
 
 // Candidate block of `radius` cells around a cell: gathers its points and returns the block's
 // bounds (infinite on sides where the grid ends, since nothing lies beyond).
-void gather_block(const Grid& grid, std::size_t cell, int radius, Scratch& scratch,
-                  double lower[3], double upper[3]) {
+void gather_block(const Grid& grid, std::size_t cell, int radius, Scratch& scratch, double lower[3],
+                  double upper[3]) {
   scratch.cx.clear();
   scratch.cy.clear();
   scratch.cz.clear();
@@ -277,7 +278,8 @@ std::size_t bucket_sort_within(const float* distances, std::size_t count, float 
   std::uint16_t* bucket_of = scratch.bucket_of.data();
   const float to_bucket = float(buckets) / limit;
   for (std::size_t i = 0; i < kept; ++i) {
-    bucket_of[i] = static_cast<std::uint16_t>(std::min(int(distances[within[i]] * to_bucket), buckets - 1));
+    bucket_of[i] =
+        static_cast<std::uint16_t>(std::min(int(distances[within[i]] * to_bucket), buckets - 1));
     ++start[bucket_of[i]];
   }
   std::uint32_t offset = 0;
@@ -293,16 +295,15 @@ std::size_t bucket_sort_within(const float* distances, std::size_t count, float 
   return kept;
 }
 
-// Selects the k nearest candidates of the query, nearest first; false when the k-th lies farther than the
-// block's guaranteed radius (then a candidate outside the block could be closer).
+// Selects the k nearest candidates of the query, nearest first; false when the k-th lies farther
+// than the block's guaranteed radius (then a candidate outside the block could be closer).
 bool select_from_block(const Grid& grid, std::uint32_t slot, const double lower[3],
                        const double upper[3], int k, Scratch& scratch) {
   const std::size_t count = scratch.cx.size();
   if (count < static_cast<std::size_t>(k)) return false;
   const float qx = grid.xs[slot], qy = grid.ys[slot], qz = grid.zs[slot];
-  const double guaranteed =
-      std::min({qx - lower[0], upper[0] - qx, qy - lower[1], upper[1] - qy, qz - lower[2],
-                upper[2] - qz});
+  const double guaranteed = std::min(
+      {qx - lower[0], upper[0] - qx, qy - lower[1], upper[1] - qy, qz - lower[2], upper[2] - qz});
   scratch.distances.resize(count);
   scratch.ranked.resize(count);
   const float* cx = scratch.cx.data();
@@ -350,8 +351,8 @@ NeighbourhoodStats for_each_neighbourhood(const PointCloud& cloud,
   if (k < 1) throw Error("", "neighbourhood search", "k must be at least 1");
   if (cloud.size() < static_cast<std::size_t>(k)) {
     throw Error("", "neighbourhood search",
-                "the cloud has " + std::to_string(cloud.size()) + " points, fewer than k = " +
-                    std::to_string(k));
+                "the cloud has " + std::to_string(cloud.size()) +
+                    " points, fewer than k = " + std::to_string(k));
   }
 
   NeighbourhoodStats stats;

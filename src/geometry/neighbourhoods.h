@@ -22,9 +22,9 @@ namespace glint::geometry {
 // nearest first, so the first s entries are the s nearest for every s <= k (ties broken
 // arbitrarily). Positions are relative to the query point (better float precision).
 struct Neighbourhood {
-  std::uint32_t point = 0;       // index of the query point in the cloud
-  int size = 0;                  // k
-  const float* dx = nullptr;     // neighbour position minus query position, `size` entries
+  std::uint32_t point = 0;    // index of the query point in the cloud
+  int size = 0;               // k
+  const float* dx = nullptr;  // neighbour position minus query position, `size` entries
   const float* dy = nullptr;
   const float* dz = nullptr;
   const std::uint32_t* indices = nullptr;  // neighbour indices in the cloud
@@ -48,9 +48,9 @@ struct NeighbourhoodStats {
 // must be thread-safe; the Neighbourhood's arrays are valid only during the call).
 // progress(points_done) is called now and then from worker threads (may be empty).
 // Throws glint::Error when the cloud has fewer points than k or k < 1.
-NeighbourhoodStats for_each_neighbourhood(
-    const PointCloud& cloud, const NeighbourhoodParams& params,
-    const std::function<void(const Neighbourhood&)>& visit,
-    const std::function<void(std::size_t)>& progress = {});
+NeighbourhoodStats for_each_neighbourhood(const PointCloud& cloud,
+                                          const NeighbourhoodParams& params,
+                                          const std::function<void(const Neighbourhood&)>& visit,
+                                          const std::function<void(std::size_t)>& progress = {});
 
 }  // namespace glint::geometry

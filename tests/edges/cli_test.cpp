@@ -1,7 +1,6 @@
 // The glint executable end to end: synth -> train -> classify -> eval, and its error contract
 // (one line naming the file, exit code 1, no output left behind).
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <cstdlib>
@@ -26,8 +25,9 @@ class CliTest : public ::testing::Test {
  protected:
   void SetUp() override {
     folder_ = fs::temp_directory_path() /
-              ("glint_cli_test_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
-               "_" + std::to_string(::getpid()));
+              ("glint_cli_test_" +
+               std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
+               std::to_string(::getpid()));
     fs::remove_all(folder_);
     fs::create_directories(folder_);
   }
@@ -48,13 +48,15 @@ class CliTest : public ::testing::Test {
 };
 
 TEST_F(CliTest, SynthTrainClassifyEval) {
-  const CommandResult synth = glint("edges synth -o " + path("clouds") +
-                          " --count 4 --seed 5 --min-points 1500 --max-points 2500 --shapes box,sheet");
+  const CommandResult synth =
+      glint("edges synth -o " + path("clouds") +
+            " --count 4 --seed 5 --min-points 1500 --max-points 2500 --shapes box,sheet");
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
   ASSERT_TRUE(fs::exists(path("clouds/manifest.json")));
 
-  const CommandResult train = glint("edges train " + path("clouds") + " --iterations 30 --batch 1024 --seed 3 -o " +
-                          path("model.json") + " --report " + path("train.json"));
+  const CommandResult train =
+      glint("edges train " + path("clouds") + " --iterations 30 --batch 1024 --seed 3 -o " +
+            path("model.json") + " --report " + path("train.json"));
   ASSERT_EQ(train.exit_code, 0) << train.output;
   const auto model = nlohmann::json::parse(std::ifstream(path("model.json")));
   EXPECT_EQ(model["parameter_count"], 1595);
@@ -63,9 +65,9 @@ TEST_F(CliTest, SynthTrainClassifyEval) {
   std::string first_cloud;
   for (const auto& entry : fs::directory_iterator(path("clouds")))
     if (entry.path().extension() == ".ply") first_cloud = entry.path().string();
-  const CommandResult classify = glint("edges classify " + first_cloud + " -o " + path("out.ply") + " --model " +
-                             path("model.json") + " --png " + path("out.png") + " --report " +
-                             path("classify.json"));
+  const CommandResult classify = glint("edges classify " + first_cloud + " -o " + path("out.ply") +
+                                       " --model " + path("model.json") + " --png " +
+                                       path("out.png") + " --report " + path("classify.json"));
   ASSERT_EQ(classify.exit_code, 0) << classify.output;
   const PointCloud out = io::read_point_cloud(path("out.ply"));
   EXPECT_TRUE(out.get<std::uint8_t>("scalar_label"));
@@ -75,8 +77,8 @@ TEST_F(CliTest, SynthTrainClassifyEval) {
   EXPECT_TRUE(out.get<std::uint8_t>("label"));  // the input's own properties are kept
   EXPECT_GT(fs::file_size(path("out.png")), 0u);
 
-  const CommandResult eval = glint("edges eval " + path("clouds") + " --model " + path("model.json") +
-                         " --report " + path("eval.json"));
+  const CommandResult eval = glint("edges eval " + path("clouds") + " --model " +
+                                   path("model.json") + " --report " + path("eval.json"));
   ASSERT_EQ(eval.exit_code, 0) << eval.output;
   EXPECT_NE(eval.output.find("median"), std::string::npos) << eval.output;
   const auto report = nlohmann::json::parse(std::ifstream(path("eval.json")));

@@ -11,7 +11,16 @@
 namespace glint::edges {
 namespace {
 
-enum Feature { kSigmaUpper1 = 0, kSigmaLower1 = 3, kDPerp = 6, kDPar, kSPerp, kSPar, kCPerp, kCPar };
+enum Feature {
+  kSigmaUpper1 = 0,
+  kSigmaLower1 = 3,
+  kDPerp = 6,
+  kDPar,
+  kSPerp,
+  kSPar,
+  kCPerp,
+  kCPar
+};
 
 // Jittered grid of spacing h on a plane patch, mapped into 3D by `place(u, v)`.
 template <class Place>
@@ -28,7 +37,8 @@ void add_patch(PointCloud& cloud, int nu, int nv, float h, std::mt19937& rng, Pl
 std::size_t nearest_to(const PointCloud& cloud, const Eigen::Vector3f& target) {
   std::size_t best = 0;
   for (std::size_t i = 1; i < cloud.size(); ++i) {
-    if ((cloud.point(i) - target).squaredNorm() < (cloud.point(best) - target).squaredNorm()) best = i;
+    if ((cloud.point(i) - target).squaredNorm() < (cloud.point(best) - target).squaredNorm())
+      best = i;
   }
   return best;
 }
@@ -69,8 +79,10 @@ TEST(Features, HalfPlaneEdgeHasLargeTangentialOffset) {
 TEST(Features, RightAngleCreaseSeparatesUpperAndLower) {
   std::mt19937 rng(3);
   PointCloud crease;  // an L: floor z = 0 (y >= 0) and wall y = 0 (z >= 0), crease on the x axis
-  add_patch(crease, 60, 30, h, rng, [](float u, float v) { return Eigen::Vector3f(u, v + h / 2, 0.f); });
-  add_patch(crease, 60, 30, h, rng, [](float u, float v) { return Eigen::Vector3f(u, 0.f, v + h / 2); });
+  add_patch(crease, 60, 30, h, rng,
+            [](float u, float v) { return Eigen::Vector3f(u, v + h / 2, 0.f); });
+  add_patch(crease, 60, 30, h, rng,
+            [](float u, float v) { return Eigen::Vector3f(u, 0.f, v + h / 2); });
   crease.push_back(0.3f, 0.f, 0.f);
   const std::size_t on_crease = crease.size() - 1;
   const FeatureMatrix f = compute_features(crease);
@@ -78,7 +90,8 @@ TEST(Features, RightAngleCreaseSeparatesUpperAndLower) {
     EXPECT_GT(f.at(on_crease, s, kDPerp), 0.3f) << "scale " << s;
     float difference = 0, size = 0;
     for (int i = 0; i < 3; ++i) {
-      const float upper = f.at(on_crease, s, kSigmaUpper1 + i), lower = f.at(on_crease, s, kSigmaLower1 + i);
+      const float upper = f.at(on_crease, s, kSigmaUpper1 + i),
+                  lower = f.at(on_crease, s, kSigmaLower1 + i);
       difference += (upper - lower) * (upper - lower);
       size += upper * upper + lower * lower;
     }
@@ -90,9 +103,8 @@ TEST(Features, RightAngleCreaseSeparatesUpperAndLower) {
 TEST(Features, ValuesAreFiniteAndOrderIndependentOfThreads) {
   std::mt19937 rng(4);
   PointCloud cloud;
-  add_patch(cloud, 40, 40, h, rng, [](float u, float v) {
-    return Eigen::Vector3f(u, v, 0.1f * std::sin(20 * u));
-  });
+  add_patch(cloud, 40, 40, h, rng,
+            [](float u, float v) { return Eigen::Vector3f(u, v, 0.1f * std::sin(20 * u)); });
   const FeatureMatrix a = compute_features(cloud);
   const FeatureMatrix b = compute_features(cloud);
   ASSERT_EQ(a.values.size(), b.values.size());

@@ -196,8 +196,8 @@ TEST(ModelTest, SaveLoadRoundTripIsExact) {
     config.classes = classes;
     Model model = random_model(config, 11 + classes);
     model.input_std[5] = Model::kMinInputStd;
-    model.layers[0].weights[0] = 1e-30f;                 // tiny and
-    model.layers[1].weights[3] = -3.40282347e38f;       // huge floats survive too
+    model.layers[0].weights[0] = 1e-30f;           // tiny and
+    model.layers[1].weights[3] = -3.40282347e38f;  // huge floats survive too
     model.training_info = {{"command", "glint edges train a.ply -o m.json"}, {"seed", 5}};
     const std::string path = dir.file("model" + std::to_string(classes) + ".json");
     model.save(path);
@@ -243,9 +243,9 @@ class MalformedModelTest : public ::testing::Test {
 };
 
 TEST_F(MalformedModelTest, MissingKeys) {
-  for (const char* key : {"format", "version", "classes", "scales", "features_per_scale",
-                          "fusion_width", "hidden", "hidden_layers", "leaky_slope",
-                          "input_mean", "input_std", "layers", "parameter_count"})
+  for (const char* key :
+       {"format", "version", "classes", "scales", "features_per_scale", "fusion_width", "hidden",
+        "hidden_layers", "leaky_slope", "input_mean", "input_std", "layers", "parameter_count"})
     expect_rejected([key](nlohmann::json& j) { j.erase(key); }, key);
   expect_rejected([](nlohmann::json& j) { j["layers"][2].erase("bias"); }, "layers[2].bias");
 }

@@ -61,9 +61,9 @@ TEST(Synth, OpenSheetsHaveBoundariesAndNoCreases) {
 }
 
 TEST(Synth, ClosedShapesHaveNoBoundary) {
-  for (SynthShape shape : {SynthShape::box, SynthShape::thin_wall, SynthShape::fractal_cube,
-                           SynthShape::stairs, SynthShape::cylinder, SynthShape::cone,
-                           SynthShape::frustum}) {
+  for (SynthShape shape :
+       {SynthShape::box, SynthShape::thin_wall, SynthShape::fractal_cube, SynthShape::stairs,
+        SynthShape::cylinder, SynthShape::cone, SynthShape::frustum}) {
     const auto counts = label_counts(synthesize_cloud(clean_params(shape), 2));
     EXPECT_EQ(counts[2], 0u) << synth_shape_names()[int(shape)];
     EXPECT_GT(counts[1], 0u) << synth_shape_names()[int(shape)];

@@ -165,8 +165,7 @@ TEST(TrainTest, ClassWeightsAndNoValidationAreAccepted) {
   params.focal_gamma = 0.0;  // plain weighted cross-entropy
   const Model model = train_model(data, ModelConfig{}, params);
   EXPECT_FALSE(model.training_info["final"].contains("validation_loss"));
-  EXPECT_EQ(model.training_info["validation_points_per_class"],
-            nlohmann::json({0, 0, 0}));
+  EXPECT_EQ(model.training_info["validation_points_per_class"], nlohmann::json({0, 0, 0}));
 }
 
 TEST(TrainTest, RejectsInconsistentDataAndParameters) {

@@ -46,23 +46,25 @@ TEST(Neighbourhoods, EveryPrefixEqualsExactKnn) {
   std::size_t mismatches = 0;
   NeighbourhoodParams params;
   params.k = sizes[0];
-  const NeighbourhoodStats stats = for_each_neighbourhood(cloud, params, [&](const Neighbourhood& nb) {
-    std::size_t local_mismatch = 0;
-    for (const int s : sizes) {
-      // The s-th distance must equal the exact s-th distance (ties allow other indices).
-      float worst = 0;
-      for (int j = 0; j < s; ++j) worst = std::max(worst, squared_distance(cloud, nb.point, nb.indices[j]));
-      const float expected = exact.squared_distances[std::size_t(nb.point) * sizes[0] + s - 1];
-      if (std::abs(worst - expected) > 1e-6f * std::max(1.f, expected)) ++local_mismatch;
-    }
-    for (int j = 0; j < nb.size; ++j) {
-      const std::uint32_t i = nb.indices[j];
-      if (std::abs(nb.dx[j] - (cloud.x[i] - cloud.x[nb.point])) > 1e-6f) ++local_mismatch;
-    }
-    std::lock_guard<std::mutex> lock(mutex);
-    ++visits[nb.point];
-    mismatches += local_mismatch;
-  });
+  const NeighbourhoodStats stats =
+      for_each_neighbourhood(cloud, params, [&](const Neighbourhood& nb) {
+        std::size_t local_mismatch = 0;
+        for (const int s : sizes) {
+          // The s-th distance must equal the exact s-th distance (ties allow other indices).
+          float worst = 0;
+          for (int j = 0; j < s; ++j)
+            worst = std::max(worst, squared_distance(cloud, nb.point, nb.indices[j]));
+          const float expected = exact.squared_distances[std::size_t(nb.point) * sizes[0] + s - 1];
+          if (std::abs(worst - expected) > 1e-6f * std::max(1.f, expected)) ++local_mismatch;
+        }
+        for (int j = 0; j < nb.size; ++j) {
+          const std::uint32_t i = nb.indices[j];
+          if (std::abs(nb.dx[j] - (cloud.x[i] - cloud.x[nb.point])) > 1e-6f) ++local_mismatch;
+        }
+        std::lock_guard<std::mutex> lock(mutex);
+        ++visits[nb.point];
+        mismatches += local_mismatch;
+      });
   EXPECT_EQ(mismatches, 0u);
   EXPECT_TRUE(std::all_of(visits.begin(), visits.end(), [](int v) { return v == 1; }));
   EXPECT_GT(stats.fallback_queries, 0u);  // the outliers
