@@ -1,7 +1,10 @@
 // glint edges train: trains a BoundED network on labelled point clouds and writes the model file.
 #include <fmt/format.h>
 
+#include <dlfcn.h>
+
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 
@@ -9,9 +12,10 @@
 #include "commands.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/progress.h"
 #include "core/timer.h"
 #include "edges/features.h"
-#include "edges/train.h"
+#include "edges/train_plugin.h"
 #include "io/json_report.h"
 #include "io/point_cloud_io.h"
 
@@ -27,6 +31,31 @@ struct TrainOptions {
   edges::ModelConfig config;
   edges::TrainParams params;
 };
+
+// Trains in the plugin module (see edges/train_plugin.h): $GLINT_TRAIN_PLUGIN, else the one
+// built beside this executable.
+edges::Model train_in_plugin(const edges::TrainingSet& set, const edges::ModelConfig& config,
+                             const edges::TrainParams& params) {
+  const char* override_path = std::getenv("GLINT_TRAIN_PLUGIN");
+  const std::string path = override_path ? override_path : GLINT_TRAIN_PLUGIN;
+  // Never closed: libtorch does not support being unloaded.
+  void* module = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (!module)
+    throw Error(path, "", std::string("cannot load the training plugin (set GLINT_TRAIN_PLUGIN): ") +
+                              dlerror());
+  const auto entry =
+      reinterpret_cast<edges::TrainPluginEntry>(dlsym(module, edges::kTrainPluginEntry));
+  if (!entry) throw Error(path, edges::kTrainPluginEntry, "not a glint training plugin");
+  edges::Model model;
+  edges::TrainPluginCall call;
+  call.data = &set;
+  call.config = &config;
+  call.params = &params;
+  call.quiet = is_quiet();
+  call.result = &model;
+  if (entry(&call) != 0) throw Error(call.error_file, call.error_element, call.error_reason);
+  return model;
+}
 
 bool name_matches_any(const std::string& file, const std::vector<std::string>& patterns) {
   const std::string name = std::filesystem::path(file).filename().string();
@@ -99,7 +128,7 @@ void run_train(const TrainOptions& options) {
   edges::Model model;
   {
     ScopedStage stage(timings, "training");
-    model = edges::train_model(set, options.config, options.params);
+    model = train_in_plugin(set, options.config, options.params);
   }
   model.training_info["command_line"] = command_line();
   model.training_info["files"] = file_entries;

@@ -8,6 +8,9 @@ namespace glint {
 
 spdlog::logger& log() {
   static std::shared_ptr<spdlog::logger> logger = [] {
+    // A plugin (the training module) has its own copy of this function but shares spdlog's
+    // registry with the executable: it finds the executable's logger there.
+    if (auto existing = spdlog::get("glint")) return existing;
     auto created = spdlog::stderr_color_mt("glint");
     created->set_pattern("[%^%l%$] %v");
     created->set_level(spdlog::level::info);
