@@ -29,8 +29,9 @@ struct EvalOptions {
   std::string report;
 };
 
-std::vector<std::uint8_t> labels_of(const PointCloud& cloud, const std::string& path) {
-  auto labels = io::read_labels(cloud);
+std::vector<std::uint8_t> labels_of(const PointCloud& cloud, const std::string& path,
+                                    io::LabelSource source = io::LabelSource::truth) {
+  auto labels = io::read_labels(cloud, source);
   if (!labels) throw Error(path, "", "has no label property (label, scalar_label or class)");
   return *labels;
 }
@@ -107,7 +108,8 @@ void run_eval(EvalOptions options) {
       if (!options.predictions.empty()) {
         const std::string prediction_path = prediction_for(options.predictions, f, path);
         const PointCloud predicted = io::read_point_cloud(prediction_path);
-        record("predictions", labels_of(predicted, prediction_path), 0.0);
+        record("predictions", labels_of(predicted, prediction_path, io::LabelSource::prediction),
+               0.0);
       }
       if (!options.no_baseline) {
         Stopwatch watch;

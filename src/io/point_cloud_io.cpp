@@ -49,8 +49,10 @@ void write_point_cloud(const std::string& path, const PointCloud& cloud) {
                   extension));
 }
 
-std::optional<std::vector<std::uint8_t>> read_labels(const PointCloud& cloud) {
-  for (const char* name : {"label", "scalar_label", "class", "scalar_class"}) {
+std::optional<std::vector<std::uint8_t>> read_labels(const PointCloud& cloud, LabelSource source) {
+  static const char* const truth_order[] = {"label", "scalar_label", "class", "scalar_class"};
+  static const char* const prediction_order[] = {"scalar_label", "scalar_class", "label", "class"};
+  for (const char* name : source == LabelSource::truth ? truth_order : prediction_order) {
     const AttributeColumn* column = cloud.find(name);
     if (!column) continue;
     std::vector<std::uint8_t> labels(cloud.size());

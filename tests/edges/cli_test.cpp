@@ -77,6 +77,16 @@ TEST_F(CliTest, SynthTrainClassifyEval) {
   EXPECT_TRUE(out.get<std::uint8_t>("label"));  // the input's own properties are kept
   EXPECT_GT(fs::file_size(path("out.png")), 0u);
 
+  // --pred on the classify output scores its scalar_label, not the input's label it keeps.
+  const CommandResult scored =
+      glint("edges eval " + first_cloud + " --pred " + path("out.ply") + " --model " +
+            path("model.json") + " --no-baseline --report " + path("pred.json"));
+  ASSERT_EQ(scored.exit_code, 0) << scored.output;
+  const auto pred = nlohmann::json::parse(std::ifstream(path("pred.json")));
+  const auto& scores = pred["files"][0]["scores"];
+  EXPECT_EQ(scores["predictions"]["tp"], scores["glint:model"]["tp"]);
+  EXPECT_EQ(scores["predictions"]["fp"], scores["glint:model"]["fp"]);
+
   const CommandResult eval = glint("edges eval " + path("clouds") + " --model " +
                                    path("model.json") + " --report " + path("eval.json"));
   ASSERT_EQ(eval.exit_code, 0) << eval.output;

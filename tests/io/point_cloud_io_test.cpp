@@ -70,6 +70,8 @@ TEST(Labels, TheFirstPresentNameIsUsed) {
   EXPECT_EQ(*read_labels(cloud), (std::vector<std::uint8_t>{2, 1}));
   cloud.set("label", std::vector<double>{0, 255});
   EXPECT_EQ(*read_labels(cloud), (std::vector<std::uint8_t>{0, 255}));
+  // A classified cloud keeps the input's "label": its prediction is "scalar_label".
+  EXPECT_EQ(*read_labels(cloud, LabelSource::prediction), (std::vector<std::uint8_t>{2, 1}));
   cloud.remove("label");
   cloud.remove("scalar_label");
   cloud.set("scalar_class", std::vector<std::int32_t>{3, 4});
