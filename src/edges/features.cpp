@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/log.h"
 #include "core/progress.h"
 #include "geometry/covariance.h"
 #include "geometry/neighbourhoods.h"
@@ -213,12 +214,16 @@ FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& par
   geometry::NeighbourhoodParams search;
   search.k = params.scales[0];
   ProgressBar progress("features", cloud.size());
-  geometry::for_each_neighbourhood(
+  const geometry::NeighbourhoodStats stats = geometry::for_each_neighbourhood(
       cloud, search,
       [&](const geometry::Neighbourhood& nb) {
         point_features(nb, params.scales, scratches.local(), features.row(nb.point));
       },
       [&](std::size_t done) { progress.advance(done); });
+  log().debug("neighbourhoods: {} points, {} grid cells of {:.4g}, {} queries retried on a larger "
+              "block, {} answered by the k-d tree",
+              cloud.size(), stats.cells, stats.cell_size, stats.retried_queries,
+              stats.fallback_queries);
   return features;
 }
 
