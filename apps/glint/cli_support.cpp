@@ -48,9 +48,7 @@ std::string models_directory() {
   return GLINT_SOURCE_MODELS_DIR;
 }
 
-std::string default_edges_model(int classes) {
-  return models_directory() + (classes == 2 ? "/bounded-2c.json" : "/bounded-3c.json");
-}
+std::string default_edges_model() { return models_directory() + "/bounded-3c.json"; }
 
 namespace {
 std::string recorded_command_line;

@@ -11,8 +11,8 @@ std::vector<std::string> expand_point_cloud_inputs(const std::vector<std::string
 
 // Where shipped models live: $GLINT_MODELS, else the source tree's models/ folder.
 std::string models_directory();
-// The shipped BoundED model: bounded-3c.json (classes = 3) or bounded-2c.json (classes = 2).
-std::string default_edges_model(int classes = 3);
+// The shipped 3-class BoundED model, the default of classify and eval.
+std::string default_edges_model();
 
 // The command line as one string, for reports and model provenance (main() records it).
 void remember_command_line(int argc, char** argv);

@@ -30,7 +30,7 @@ void run_classify(const ClassifyOptions& options) {
     throw Error(options.output, "", "the output must be a .ply file");
   }
   PointCloud cloud = io::read_point_cloud(options.input);
-  const std::string model_path = options.model.empty() ? default_edges_model(3) : options.model;
+  const std::string model_path = options.model.empty() ? default_edges_model() : options.model;
   const edges::Model model = edges::Model::load(model_path);
   log().info("{}: {} points; model {} ({} classes, scales {})", options.input, cloud.size(),
              model_path, model.config.classes, fmt::join(model.config.scales, ","));
@@ -54,14 +54,7 @@ void run_classify(const ClassifyOptions& options) {
       result.inference_s, double(cloud.size()) / total_s, options.output);
 
   if (!options.png.empty()) {
-    std::vector<std::uint8_t> rgb(3 * cloud.size());
-    const auto* red = cloud.get<std::uint8_t>("red");
-    const auto* green = cloud.get<std::uint8_t>("green");
-    const auto* blue = cloud.get<std::uint8_t>("blue");
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-      rgb[3 * i] = (*red)[i], rgb[3 * i + 1] = (*green)[i], rgb[3 * i + 2] = (*blue)[i];
-    }
-    write_point_preview(options.png, cloud, rgb);
+    write_point_preview(options.png, cloud);
     fmt::print("picture -> {}\n", options.png);
   }
   if (!options.report.empty()) {

@@ -65,7 +65,7 @@ void run_eval(EvalOptions options) {
     throw Error("", "--pred", "give one prediction file per ground-truth file, or one folder");
   }
   if (options.models.empty() && options.predictions.empty()) {
-    options.models.push_back(default_edges_model(3));
+    options.models.push_back(default_edges_model());
   }
   std::vector<std::pair<std::string, edges::Model>> models;
   for (const auto& path : options.models) {
@@ -101,9 +101,18 @@ void run_eval(EvalOptions options) {
       file_json["scores"][method]["seconds"] = seconds;
     };
     try {
+      // Models with the same scales share one feature matrix (features dominate the time).
+      std::map<std::vector<int>, std::pair<edges::FeatureMatrix, double>> features_by_scales;
       for (const auto& [method, model] : models) {
-        const edges::Classification result = edges::classify(cloud, model);
-        record(method, result.labels, result.features_s + result.inference_s);
+        auto [entry, is_new] = features_by_scales.try_emplace(model.config.scales);
+        auto& [features, features_s] = entry->second;
+        if (is_new) {
+          const Stopwatch watch;
+          features = edges::compute_features(cloud, edges::FeatureParams{model.config.scales});
+          features_s = watch.elapsed_s();
+        }
+        const edges::Classification result = edges::classify_features(features, model);
+        record(method, result.labels, features_s + result.inference_s);
       }
       if (!options.predictions.empty()) {
         const std::string prediction_path = prediction_for(options.predictions, f, path);
@@ -123,19 +132,16 @@ void run_eval(EvalOptions options) {
   }
 
   nlohmann::json summary_json;
+  std::map<std::string, edges::ScoreSummary> summaries;
   for (const auto& method : methods) {
-    const edges::ScoreSummary summary = edges::summarise(per_method[method]);
-    print_row("median", method, summary.median);
+    const edges::ScoreSummary& summary = summaries[method] = edges::summarise(per_method[method]);
     summary_json[method] = {{"median", edges::to_json(summary.median)},
                             {"mean", edges::to_json(summary.mean)},
                             {"all_points", edges::to_json(summary.pooled)}};
   }
-  for (const auto& method : methods) {
-    print_row("mean", method, edges::summarise(per_method[method]).mean);
-  }
-  for (const auto& method : methods) {
-    print_row("all points", method, edges::summarise(per_method[method]).pooled);
-  }
+  for (const auto& method : methods) print_row("median", method, summaries[method].median);
+  for (const auto& method : methods) print_row("mean", method, summaries[method].mean);
+  for (const auto& method : methods) print_row("all points", method, summaries[method].pooled);
   if (!options.report.empty()) {
     io::write_json(options.report, {{"command", command_line()},
                                     {"task", options.task},

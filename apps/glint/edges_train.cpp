@@ -1,7 +1,6 @@
 // glint edges train: trains a BoundED network on labelled point clouds and writes the model file.
-#include <fmt/format.h>
-
 #include <dlfcn.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -41,8 +40,9 @@ edges::Model train_in_plugin(const edges::TrainingSet& set, const edges::ModelCo
   // Never closed: libtorch does not support being unloaded.
   void* module = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!module)
-    throw Error(path, "", std::string("cannot load the training plugin (set GLINT_TRAIN_PLUGIN): ") +
-                              dlerror());
+    throw Error(
+        path, "",
+        std::string("cannot load the training plugin (set GLINT_TRAIN_PLUGIN): ") + dlerror());
   const auto entry =
       reinterpret_cast<edges::TrainPluginEntry>(dlsym(module, edges::kTrainPluginEntry));
   if (!entry) throw Error(path, edges::kTrainPluginEntry, "not a glint training plugin");

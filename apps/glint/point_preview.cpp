@@ -12,10 +12,13 @@
 namespace glint::app {
 
 void write_point_preview(const std::string& path, const PointCloud& cloud,
-                         const std::vector<std::uint8_t>& rgb, const PreviewParams& params) {
+                         const PreviewParams& params) {
   const std::size_t n = cloud.size();
   if (n == 0) throw Error(path, "", "nothing to draw: the cloud is empty");
-  if (rgb.size() != 3 * n) throw Error(path, "", "one colour per point is needed");
+  const auto* red = cloud.get<std::uint8_t>("red");
+  const auto* green = cloud.get<std::uint8_t>("green");
+  const auto* blue = cloud.get<std::uint8_t>("blue");
+  if (!red || !green || !blue) throw Error(path, "", "the cloud has no uchar red/green/blue");
 
   const double azimuth = params.azimuth_deg * std::numbers::pi / 180.0;
   const double elevation = params.elevation_deg * std::numbers::pi / 180.0;
@@ -59,9 +62,9 @@ void write_point_preview(const std::string& path, const PointCloud& cloud,
     const int px = int(std::lround(params.width / 2.0 + (u[i] - centre_u) * pixels_per_unit));
     const int py = int(std::lround(params.height / 2.0 - (v[i] - centre_v) * pixels_per_unit));
     const double shade = 0.55 + 0.45 * (d_max > d_min ? (depth[i] - d_min) / (d_max - d_min) : 1.0);
-    const cv::Vec3b colour(cv::saturate_cast<uchar>(rgb[3 * i + 2] * shade),
-                           cv::saturate_cast<uchar>(rgb[3 * i + 1] * shade),
-                           cv::saturate_cast<uchar>(rgb[3 * i + 0] * shade));
+    const cv::Vec3b colour(cv::saturate_cast<uchar>((*blue)[i] * shade),
+                           cv::saturate_cast<uchar>((*green)[i] * shade),
+                           cv::saturate_cast<uchar>((*red)[i] * shade));
     for (int y = std::max(0, py - radius); y <= std::min(params.height - 1, py + radius); ++y) {
       for (int x = std::max(0, px - radius); x <= std::min(params.width - 1, px + radius); ++x) {
         double& z = zbuffer[std::size_t(y) * params.width + x];

@@ -1,9 +1,7 @@
 #pragma once
 // A quick look at a coloured point cloud as a PNG: orthographic view, z-buffered square
 // splats, depth shading. For figures and sanity checks, not a renderer.
-#include <cstdint>
 #include <string>
-#include <vector>
 
 #include "core/point_cloud.h"
 
@@ -17,8 +15,9 @@ struct PreviewParams {
   char up_axis = 'z';         // 'y' or 'z'
 };
 
-// colours: 3 bytes (r, g, b) per point. Written atomically (temporary file + rename).
+// Colours from the cloud's uchar red/green/blue attributes. Written atomically (temporary file +
+// rename).
 void write_point_preview(const std::string& path, const PointCloud& cloud,
-                         const std::vector<std::uint8_t>& rgb, const PreviewParams& params = {});
+                         const PreviewParams& params = {});
 
 }  // namespace glint::app

@@ -6,20 +6,18 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
-#include <cmath>
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
 
 #include "core/timer.h"
+#include "edges/classifier.h"
 #include "edges/covariance_baseline.h"
-#include "edges/features.h"
 #include "edges/model.h"
 #include "edges/synth.h"
+#include "io/json_report.h"
 #include "io/point_cloud_io.h"
 
 namespace {
@@ -65,59 +63,43 @@ int main(int argc, char** argv) {
   report["parameters"] = {{"points", points}, {"model", model_path}, {"folder", folder}};
 
   const glint::edges::Model model = glint::edges::Model::load(model_path);
-  glint::edges::FeatureParams feature_params;
-  feature_params.scales = model.config.scales;
 
   const glint::PointCloud cloud = benchmark_cloud(points);
   const long rss_before_mib = peak_rss_mib();
-  glint::Stopwatch watch;
-  const glint::edges::FeatureMatrix features =
-      glint::edges::compute_features(cloud, feature_params);
-  const double features_s = watch.elapsed_s();
-  watch.restart();
-  std::vector<float> probabilities;
-  std::vector<std::uint8_t> labels;
-  model.predict(features, probabilities, labels);
-  const double classify_s = watch.elapsed_s();
+  const glint::edges::Classification result = glint::edges::classify(cloud, model);
+  const double total_s = result.features_s + result.inference_s;
   report["generated"] = {{"points", points},
-                         {"features_s", features_s},
-                         {"inference_s", classify_s},
-                         {"total_s", features_s + classify_s},
-                         {"points_per_s", double(points) / (features_s + classify_s)},
+                         {"features_s", result.features_s},
+                         {"inference_s", result.inference_s},
+                         {"total_s", total_s},
+                         {"points_per_s", double(points) / total_s},
                          {"peak_rss_mib", peak_rss_mib()},
                          {"peak_rss_before_features_mib", rss_before_mib}};
 
-  watch.restart();
-  const auto ca = glint::edges::classify_covariance_baseline(cloud);
+  const glint::Stopwatch watch;
+  glint::edges::classify_covariance_baseline(cloud);
   report["generated"]["covariance_baseline_s"] = watch.elapsed_s();
 
   if (std::filesystem::is_directory(folder)) {
-    double total_s = 0, io_s = 0;
+    double folder_s = 0, io_s = 0;
     std::size_t total_points = 0, files = 0;
     for (const auto& entry : std::filesystem::directory_iterator(folder)) {
       if (entry.path().extension() != ".ply") continue;
       glint::Stopwatch io_watch;
       const glint::PointCloud eval_cloud = glint::io::read_point_cloud(entry.path().string());
       io_s += io_watch.elapsed_s();
-      glint::Stopwatch eval_watch;
-      const auto eval_features = glint::edges::compute_features(eval_cloud, feature_params);
-      model.predict(eval_features, probabilities, labels);
-      total_s += eval_watch.elapsed_s();
+      const glint::edges::Classification eval = glint::edges::classify(eval_cloud, model);
+      folder_s += eval.features_s + eval.inference_s;
       total_points += eval_cloud.size();
       ++files;
     }
     report["folder"] = {{"files", files},
                         {"points", total_points},
-                        {"features_and_classification_s", total_s},
+                        {"features_and_classification_s", folder_s},
                         {"io_s", io_s},
                         {"thesis_gpu_s", 1.0}};
   }
-  const std::string text = report.dump(2);
-  if (json_path.empty()) {
-    std::cout << text << "\n";
-  } else {
-    std::ofstream(json_path) << text << "\n";
-    std::cout << text << "\n";
-  }
+  if (!json_path.empty()) glint::io::write_json(json_path, report);
+  std::cout << report.dump(2) << "\n";
   return 0;
 }

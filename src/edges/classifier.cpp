@@ -16,19 +16,25 @@ Classification classify(const PointCloud& cloud, const Model& model,
                 "the model was trained on " + std::to_string(model.config.scales.size()) +
                     " scales; got " + std::to_string(params.scales.size()));
   }
-  Classification result;
-  Stopwatch watch;
+  const Stopwatch watch;
   const FeatureMatrix features = compute_features(cloud, params);
-  result.features_s = watch.elapsed_s();
-  watch.restart();
+  const double features_s = watch.elapsed_s();
+  Classification result = classify_features(features, model);
+  result.features_s = features_s;
+  return result;
+}
+
+Classification classify_features(const FeatureMatrix& features, const Model& model) {
+  Classification result;
+  const Stopwatch watch;
   std::vector<float> probabilities;
   model.predict(features, probabilities, result.labels);
   result.inference_s = watch.elapsed_s();
 
   const std::size_t classes = static_cast<std::size_t>(model.config.classes);
-  result.p_sharp.resize(cloud.size());
-  result.p_boundary.assign(cloud.size(), 0.f);
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
+  result.p_sharp.resize(features.points);
+  result.p_boundary.assign(features.points, 0.f);
+  for (std::size_t i = 0; i < features.points; ++i) {
     result.p_sharp[i] = probabilities[i * classes + 1];
     if (classes > 2) result.p_boundary[i] = probabilities[i * classes + 2];
   }

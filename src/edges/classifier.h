@@ -21,6 +21,9 @@ struct Classification {
 // e.g. for a much denser or sparser cloud than the training data); empty = the model's.
 Classification classify(const PointCloud& cloud, const Model& model,
                         const std::vector<int>& scales = {});
+// The network part alone, on features computed at the model's scale count (several models
+// with the same scales can share one feature matrix); features_s stays 0.
+Classification classify_features(const FeatureMatrix& features, const Model& model);
 
 // Adds the DESIGN.md output attributes: uchar scalar_label, float scalar_p_sharp,
 // float scalar_p_boundary, and uchar red/green/blue (red = sharp, green = boundary, grey = rest).

@@ -220,10 +220,10 @@ FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& par
         point_features(nb, params.scales, scratches.local(), features.row(nb.point));
       },
       [&](std::size_t done) { progress.advance(done); });
-  log().debug("neighbourhoods: {} points, {} grid cells of {:.4g}, {} queries retried on a larger "
-              "block, {} answered by the k-d tree",
-              cloud.size(), stats.cells, stats.cell_size, stats.retried_queries,
-              stats.fallback_queries);
+  log().debug(
+      "neighbourhoods: {} points, {} grid cells of {:.4g}, {} queries retried on a larger "
+      "block, {} answered by the k-d tree",
+      cloud.size(), stats.cells, stats.cell_size, stats.retried_queries, stats.fallback_queries);
   return features;
 }
 

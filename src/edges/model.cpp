@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -238,14 +237,7 @@ void Model::save(const std::string& path) const { io::write_json(path, to_json()
 
 Model Model::load(const std::string& path) {
   const FileReader reader(path);
-  std::ifstream stream(path);
-  if (!stream) throw Error(path, "", "cannot open the model file");
-  nlohmann::json root;
-  try {
-    root = nlohmann::json::parse(stream);
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(path, "", std::string("not a valid JSON file: ") + e.what());
-  }
+  const nlohmann::json root = io::read_json(path);
   if (!root.is_object()) reader.fail("", "expected a JSON object at the top level");
 
   const nlohmann::json& format = reader.member(root, "format", "format");

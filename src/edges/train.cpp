@@ -202,15 +202,17 @@ struct Evaluation {
   std::vector<double> recall;  // per class; NaN for classes without points
 };
 
-Evaluation evaluate(BoundedNet& net, const torch::Tensor& features, const torch::Tensor& labels,
-                    const std::vector<std::int64_t>& points, int classes, double gamma,
-                    const torch::Tensor& alpha) {
+// The net's logits in evaluation mode (dropout off), without gradients.
+torch::Tensor evaluation_logits(BoundedNet& net, const torch::Tensor& features) {
   torch::NoGradGuard no_grad;
   net->eval();
-  const torch::Tensor index = index_tensor(points);
-  const torch::Tensor targets = labels.index_select(0, index);
-  const torch::Tensor logits = net->forward(features.index_select(0, index));
+  torch::Tensor logits = net->forward(features);
   net->train();
+  return logits;
+}
+
+Evaluation evaluate(const torch::Tensor& logits, const torch::Tensor& targets, int classes,
+                    double gamma, const torch::Tensor& alpha) {
   Evaluation result;
   result.loss = focal_loss(logits, targets, gamma, alpha).item<double>();
   const torch::Tensor correct = logits.argmax(1).eq(targets);
@@ -241,15 +243,8 @@ double mean_edge_f1(const torch::Tensor& predicted, const torch::Tensor& targets
 
 // The offset for the non-edge logit that maximises the mean edge F1 on the given points, from a
 // grid over [-4, 8] (ties: the smallest magnitude).
-double tune_non_edge_offset(BoundedNet& net, const torch::Tensor& features,
-                            const torch::Tensor& labels, const std::vector<std::int64_t>& points,
-                            int classes, nlohmann::json& record) {
-  torch::NoGradGuard no_grad;
-  net->eval();
-  const torch::Tensor index = index_tensor(points);
-  const torch::Tensor targets = labels.index_select(0, index);
-  const torch::Tensor logits = net->forward(features.index_select(0, index));
-  net->train();
+double tune_non_edge_offset(const torch::Tensor& logits, const torch::Tensor& targets, int classes,
+                            nlohmann::json& record) {
   double best_offset = 0.0, best_f1 = -1.0, f1_at_zero = 0.0;
   for (int step = -40; step <= 80; ++step) {
     const double offset = 0.1 * step;
@@ -315,6 +310,10 @@ Model train_model(const TrainingSet& data, const ModelConfig& config, const Trai
   const torch::Tensor alpha = params.class_weights.empty()
                                   ? torch::Tensor()
                                   : torch::tensor(params.class_weights).to(torch::kFloat32);
+  // The validation points never change: select them once.
+  const torch::Tensor validation_index = index_tensor(split.validation);
+  const torch::Tensor validation_features = features.index_select(0, validation_index);
+  const torch::Tensor validation_labels = labels.index_select(0, validation_index);
 
   // Batch sampling: uniform over all training points, or class by class in turn.
   std::vector<int> present_classes;
@@ -366,8 +365,9 @@ Model train_model(const TrainingSet& data, const ModelConfig& config, const Trai
       log().info("iteration {}/{}: training loss {:.5f}", iteration, params.iterations,
                  last_train_loss);
     } else {
-      const Evaluation validation = evaluate(net, features, labels, split.validation,
-                                             config.classes, params.focal_gamma, alpha);
+      const Evaluation validation =
+          evaluate(evaluation_logits(net, validation_features), validation_labels, config.classes,
+                   params.focal_gamma, alpha);
       entry["validation_loss"] = validation.loss;
       entry["validation_accuracy"] = validation.accuracy;
       entry["validation_recall"] = recall_json(validation.recall);
@@ -397,8 +397,8 @@ Model train_model(const TrainingSet& data, const ModelConfig& config, const Trai
   }
   nlohmann::json threshold = nullptr;
   if (params.tune_threshold && !split.validation.empty()) {
-    const double offset =
-        tune_non_edge_offset(net, features, labels, split.validation, config.classes, threshold);
+    const double offset = tune_non_edge_offset(evaluation_logits(net, validation_features),
+                                               validation_labels, config.classes, threshold);
     net->shift_non_edge_logit(offset);
     log().info("non-edge logit offset {:+.1f}: mean edge F1 on validation {:.4f} (without: {:.4f})",
                offset, threshold["validation_edge_f1"].get<double>(),

@@ -37,11 +37,11 @@ struct Grid {
   double cell = 1.0;
   double origin[3] = {0, 0, 0};
   std::int64_t dims[3] = {1, 1, 1};
-  std::vector<std::uint32_t> cell_begin;  // cells + 1 offsets into the sorted arrays
-  std::vector<std::int32_t> cell_coords;  // 3 per cell
-  std::vector<std::int32_t> cell_z;       // z index per cell (binary search within a column)
-  std::vector<float> xs, ys, zs;          // positions in cell order
-  std::vector<std::uint32_t> original;    // cloud index of each sorted slot
+  std::vector<std::uint32_t> cell_begin;   // cells + 1 offsets into the sorted arrays
+  std::vector<std::uint64_t> cell_column;  // column key (x, y index) per cell
+  std::vector<std::int32_t> cell_z;        // z index per cell (binary search within a column)
+  std::vector<float> xs, ys, zs;           // positions in cell order
+  std::vector<std::uint32_t> original;     // cloud index of each sorted slot
   // Open-addressing hash: column key -> its first cell and one past its last.
   std::vector<std::uint64_t> table_keys;
   std::vector<std::uint32_t> table_first, table_end;
@@ -165,13 +165,12 @@ Grid build_grid(const PointCloud& cloud, double cell_size) {
   grid.cell_begin.push_back(static_cast<std::uint32_t>(n));
 
   const std::size_t cells = cell_keys.size();
-  grid.cell_coords.resize(3 * cells);
+  grid.cell_column.resize(cells);
   grid.cell_z.resize(cells);
+  const auto depth = static_cast<std::uint64_t>(grid.dims[2]);
   for (std::size_t c = 0; c < cells; ++c) {
-    const auto k = static_cast<std::int64_t>(cell_keys[c]);
-    grid.cell_coords[3 * c + 0] = static_cast<std::int32_t>(k / (grid.dims[1] * grid.dims[2]));
-    grid.cell_coords[3 * c + 1] = static_cast<std::int32_t>((k / grid.dims[2]) % grid.dims[1]);
-    grid.cell_coords[3 * c + 2] = grid.cell_z[c] = static_cast<std::int32_t>(k % grid.dims[2]);
+    grid.cell_column[c] = cell_keys[c] / depth;
+    grid.cell_z[c] = static_cast<std::int32_t>(cell_keys[c] % depth);
   }
   std::uint64_t capacity = 16;
   while (capacity < 2 * cells) capacity *= 2;
@@ -180,13 +179,9 @@ Grid build_grid(const PointCloud& cloud, double cell_size) {
   grid.table_first.assign(capacity, 0);
   grid.table_end.assign(capacity, 0);
   for (std::size_t c = 0; c < cells;) {
-    const std::uint64_t column =
-        grid.column_key(grid.cell_coords[3 * c], grid.cell_coords[3 * c + 1]);
+    const std::uint64_t column = grid.cell_column[c];
     std::size_t end = c + 1;
-    while (end < cells &&
-           grid.column_key(grid.cell_coords[3 * end], grid.cell_coords[3 * end + 1]) == column) {
-      ++end;
-    }
+    while (end < cells && grid.cell_column[end] == column) ++end;
     std::uint64_t slot = Grid::hash(column) & grid.table_mask;
     while (grid.table_keys[slot] != Grid::kEmpty) slot = (slot + 1) & grid.table_mask;
     grid.table_keys[slot] = column;
@@ -222,7 +217,10 @@ void gather_block(const Grid& grid, std::size_t cell, int radius, Scratch& scrat
   scratch.cy.clear();
   scratch.cz.clear();
   scratch.cslot.clear();
-  const std::int32_t* c = &grid.cell_coords[3 * cell];
+  const auto rows = static_cast<std::uint64_t>(grid.dims[1]);
+  const std::int64_t c[3] = {static_cast<std::int64_t>(grid.cell_column[cell] / rows),
+                             static_cast<std::int64_t>(grid.cell_column[cell] % rows),
+                             grid.cell_z[cell]};
   std::int64_t from[3], to[3];
   for (int a = 0; a < 3; ++a) {
     from[a] = std::max<std::int64_t>(0, c[a] - radius);
