@@ -8,4 +8,5 @@ OUT=build/bench
 mkdir -p "$OUT"
 "$BUILD/bench/edges/edges_throughput" --points 1000000 --model models/bounded-3c.json \
   --data "$DATA/pointclouds/default-eval" --json "$OUT/edges_throughput.json"
-echo "bench: results in $OUT"
+"$BUILD/bench/denoise/denoise_speed" --json "$OUT/denoise_speed.json"
+echo "bench: results in $OUT (the denoising protocol: scripts/eval-denoise.sh)"

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The main job on bundled data: classify a default-eval cloud (PLY + picture), then evaluate
-# both shipped models beside the CA baseline on all of default-eval.
+# both shipped models beside the CA baseline on all of default-eval; then guided denoising of
+# a Kodak crop.
 #   scripts/demo.sh GLINT DATA
 set -euo pipefail
 GLINT=${1:?usage: demo.sh GLINT DATA}
@@ -20,4 +21,9 @@ mkdir -p "$OUT"
 "$GLINT" edges classify "$OUT/heldout/$(ls "$OUT/heldout" | grep -m1 '\.ply$')" \
   -o "$OUT/heldout-edges.ply" --png "$OUT/heldout-edges.png"
 "$GLINT" edges eval "$OUT/heldout" --task boundary --no-baseline
+# Guided denoising: a Kodak crop with noise in random blobs; noise maps, NLM and guided S2S.
+KODAK="$DATA/images/kodak/kodim23.png"
+"$GLINT" denoise eval --images "$KODAK" --crop 128 --methods nlm,guided-s2s --save "$OUT/denoise" \
+  --report "$OUT/denoise-eval.json"
+"$GLINT" denoise noise-map "$OUT/denoise/kodim23-noisy.png" -o "$OUT/denoise/kodim23-guidance-cli.png"
 echo "demo: outputs in $OUT"

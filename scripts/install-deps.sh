@@ -6,7 +6,9 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   libeigen3-dev libnanoflann-dev libtbb-dev
-  libtorch-dev
+  # libtorch's CPU convolutions call BLAS; OpenBLAS (OpenMP-threaded, like libtorch) instead
+  # of the reference BLAS makes the denoisers' U-Net several times faster.
+  libtorch-dev libopenblas0-openmp
   libopencv-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -21,4 +21,11 @@ void register_edges_train(CLI::App& edges);
 void register_edges_synth(CLI::App& edges);
 void register_edges_eval(CLI::App& edges);
 
+void register_denoise_commands(CLI::App& app);
+
+// `glint denoise <name>` subcommands (apps/glint/denoise_<name>.cpp).
+void register_denoise_noise_map(CLI::App& denoise);
+void register_denoise_run(CLI::App& denoise);
+void register_denoise_eval(CLI::App& denoise);
+
 }  // namespace glint::app

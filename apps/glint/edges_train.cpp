@@ -1,9 +1,7 @@
 // glint edges train: trains a BoundED network on labelled point clouds and writes the model file.
-#include <dlfcn.h>
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <filesystem>
 #include <memory>
 
@@ -17,6 +15,7 @@
 #include "edges/train_plugin.h"
 #include "io/json_report.h"
 #include "io/point_cloud_io.h"
+#include "plugin_loader.h"
 
 namespace glint::app {
 namespace {
@@ -35,17 +34,8 @@ struct TrainOptions {
 // built beside this executable.
 edges::Model train_in_plugin(const edges::TrainingSet& set, const edges::ModelConfig& config,
                              const edges::TrainParams& params) {
-  const char* override_path = std::getenv("GLINT_TRAIN_PLUGIN");
-  const std::string path = override_path ? override_path : GLINT_TRAIN_PLUGIN;
-  // Never closed: libtorch does not support being unloaded.
-  void* module = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
-  if (!module)
-    throw Error(
-        path, "",
-        std::string("cannot load the training plugin (set GLINT_TRAIN_PLUGIN): ") + dlerror());
-  const auto entry =
-      reinterpret_cast<edges::TrainPluginEntry>(dlsym(module, edges::kTrainPluginEntry));
-  if (!entry) throw Error(path, edges::kTrainPluginEntry, "not a glint training plugin");
+  const auto entry = reinterpret_cast<edges::TrainPluginEntry>(
+      plugin_entry("GLINT_TRAIN_PLUGIN", GLINT_TRAIN_PLUGIN, edges::kTrainPluginEntry));
   edges::Model model;
   edges::TrainPluginCall call;
   call.data = &set;

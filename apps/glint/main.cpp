@@ -13,7 +13,7 @@
 int main(int argc, char** argv) {
   CLI::App app{
       "glint - practical real-time reflectance estimation toolkit.\n"
-      "Point-cloud edge/boundary detection (BoundED), and more to come.\n"
+      "Point-cloud edge/boundary detection (BoundED) and locally-guided image denoising.\n"
       "Run 'glint <command> --help' for the options of each command."};
   app.require_subcommand(1);
   app.set_version_flag("--version", "glint 0.1.0");
@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   app.add_option("--log-level", common.log_level, "trace, debug, info, warn, error, off");
 
   glint::app::register_edges_commands(app);
+  glint::app::register_denoise_commands(app);
 
   std::unique_ptr<tbb::global_control> thread_limit;
   app.parse_complete_callback([&] {

@@ -1,51 +1,18 @@
 // The glint executable end to end: synth -> train -> classify -> eval, and its error contract
 // (one line naming the file, exit code 1, no output left behind).
 #include <gtest/gtest.h>
-#include <unistd.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "io/point_cloud_io.h"
+#include "support/cli_fixture.h"
 
 namespace glint {
 namespace {
 
 namespace fs = std::filesystem;
-
-struct CommandResult {
-  int exit_code;
-  std::string output;  // stdout and stderr
-};
-
-// Each test gets its own folder (ctest runs tests in parallel processes).
-class CliTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    folder_ = fs::temp_directory_path() /
-              ("glint_cli_test_" +
-               std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-               std::to_string(::getpid()));
-    fs::remove_all(folder_);
-    fs::create_directories(folder_);
-  }
-  void TearDown() override { fs::remove_all(folder_); }
-
-  std::string path(const std::string& name) const { return (folder_ / name).string(); }
-
-  CommandResult glint(const std::string& arguments) const {
-    const std::string log = path("command.log");
-    const std::string command =
-        std::string(GLINT_BINARY) + " --quiet " + arguments + " > " + log + " 2>&1";
-    const int status = std::system(command.c_str());
-    std::ifstream stream(log);
-    return {WEXITSTATUS(status), std::string(std::istreambuf_iterator<char>(stream), {})};
-  }
-
-  fs::path folder_;
-};
 
 TEST_F(CliTest, SynthTrainClassifyEval) {
   const CommandResult synth =

@@ -1,0 +1,48 @@
+// denoise_neural(): checks the inputs, sets up libtorch (seed, device, threads) and runs DIP or
+// Self2Self.
+#include <chrono>
+
+#include "core/error.h"
+#include "denoise/neural_impl.h"
+#include "denoise/torch_support.h"
+
+namespace glint::denoise {
+
+void maybe_snapshot(const NeuralParams& params, int iteration,
+                    const std::function<torch::Tensor()>& estimate) {
+  if (params.snapshot && params.snapshot_every > 0 && iteration % params.snapshot_every == 0)
+    params.snapshot(iteration, to_image(estimate().clamp(0.0, 1.0)));
+}
+
+ImageF denoise_neural(const ImageF& noisy, const ImageF* guidance, const NeuralParams& params,
+                      NeuralStats* stats) {
+  if (noisy.empty()) throw Error("input image", "", "has no pixels");
+  if (is_guided(params.method)) {
+    if (!guidance) throw Error(method_name(params.method), "", "needs a guidance map");
+    if (!guidance->same_size(noisy) || guidance->channels() != 1)
+      throw Error("guidance map", "",
+                  "must be one channel of the input's size (" + std::to_string(noisy.width()) +
+                      "x" + std::to_string(noisy.height()) + ")");
+  }
+  if (params.iterations < 1 || params.net.levels < 1 || params.net.channels < 1)
+    throw Error(method_name(params.method), "", "needs iterations, levels and channels >= 1");
+
+  const auto start = std::chrono::steady_clock::now();
+  torch::manual_seed(params.seed);
+  if (params.threads > 0) torch::set_num_threads(params.threads);
+  const torch::Device device = resolve_device(params.device);
+  const torch::Tensor input = to_tensor(noisy, device);
+  const torch::Tensor guide =
+      is_guided(params.method) ? to_tensor(*guidance, device) : torch::Tensor();
+
+  NeuralStats local;
+  local.device = device.str();
+  ImageF result = is_self2self(params.method) ? run_self2self(input, guide, params, local)
+                                              : run_dip(input, guide, params, local);
+  local.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (stats) *stats = local;
+  return result;
+}
+
+}  // namespace glint::denoise

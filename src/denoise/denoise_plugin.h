@@ -1,0 +1,26 @@
+#pragma once
+// The neural denoisers as a loadable module (libglint_denoise_plugin.so): libtorch costs about
+// 0.4 s of process start-up, so only `glint denoise run|eval` with a neural method opens it.
+// Tests link glint_denoise_nets directly.
+#include <string>
+
+#include "denoise/neural.h"
+
+namespace glint::denoise {
+
+struct DenoisePluginCall {
+  const ImageF* noisy = nullptr;
+  const ImageF* guidance = nullptr;  // may be null for unguided methods
+  const NeuralParams* params = nullptr;
+  bool quiet = false;  // the module has its own copy of the progress-bar switch
+  ImageF* result = nullptr;
+  NeuralStats* stats = nullptr;
+  // Set on failure (glint::Error's parts; nothing is thrown across the module boundary).
+  std::string error_file, error_element, error_reason;
+};
+
+// extern "C" entry point of the module: 0 on success, 1 on failure.
+using DenoisePluginEntry = int (*)(DenoisePluginCall*);
+inline constexpr const char* kDenoisePluginEntry = "glint_denoise_plugin_entry";
+
+}  // namespace glint::denoise

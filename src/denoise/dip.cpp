@@ -1,0 +1,53 @@
+// Deep Image Prior, plain and guided (the guided-denoising paper, §3.2).
+#include "core/progress.h"
+#include "denoise/neural_impl.h"
+#include "denoise/torch_support.h"
+#include "denoise/unet.h"
+
+namespace glint::denoise {
+
+ImageF run_dip(const torch::Tensor& noisy, const torch::Tensor& guidance,
+               const NeuralParams& params, NeuralStats& stats) {
+  const auto height = noisy.size(2), width = noisy.size(3);
+  const int multiple = 1 << params.net.levels;
+  UNet net(params.input_channels, static_cast<int>(noisy.size(1)), params.net);
+  net->to(noisy.device());
+  stats.parameters = parameter_count(*net);
+  torch::optim::Adam optimiser(net->parameters(), torch::optim::AdamOptions(params.learning_rate));
+
+  // The fixed network input: `input_channels` planes of U[0, input_scale], padded size.
+  const torch::Tensor input =
+      pad_to_multiple(torch::zeros({1, params.input_channels, height, width}, noisy.options()),
+                      multiple)
+          .uniform_(0.0, params.input_scale);
+  // Base of eq. (16)'s decay, per pixel: 0.9 + 0.1 m.
+  const torch::Tensor decay_base = guidance.defined() ? 0.9 + 0.1 * guidance : torch::Tensor();
+
+  torch::Tensor average;
+  ProgressBar progress(method_name(params.method), static_cast<std::size_t>(params.iterations));
+  for (int i = 0; i < params.iterations; ++i) {
+    optimiser.zero_grad();
+    const torch::Tensor perturbed = input + torch::randn_like(input) * params.input_perturbation;
+    const torch::Tensor output = crop_to(net->forward(perturbed, {}), height, width);
+    torch::Tensor residual = output - noisy;
+    if (decay_base.defined() && i >= params.decay.warmup) {
+      // eq. (16): w = base^((i − κw)·κr)·(1 − κc) + κc; eq. (15): mean of (residual·w)².
+      const double exponent = (i - params.decay.warmup) * params.decay.rate;
+      residual = residual * (decay_base.pow(exponent) * (1.0 - params.decay.floor) +
+                             params.decay.floor);
+    }
+    residual.pow(2).mean().backward();
+    optimiser.step();
+    // eq. (14): exponential average of the outputs.
+    const torch::Tensor current = output.detach();
+    average = average.defined() ? params.averaging * average + (1.0 - params.averaging) * current
+                                : current;
+    maybe_snapshot(params, i + 1, [&] { return average; });
+    progress.advance();
+  }
+  progress.finish();
+  stats.iterations = params.iterations;
+  return to_image(average.clamp(0.0, 1.0));
+}
+
+}  // namespace glint::denoise

@@ -1,0 +1,152 @@
+#include "io/image_io.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <vector>
+
+#include "core/error.h"
+#include "io/atomic_file.h"
+#include "io/codec.h"
+#include "io/file_bytes.h"
+
+namespace glint::io {
+namespace {
+
+// OpenCV 4.6 decodes and encodes OpenEXR only when this variable is set, and looks at it once,
+// on the first EXR access: set it (leaving a user's own setting alone) before any codec runs.
+void enable_openexr() {
+  static const bool enabled = [] { return ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0) == 0; }();
+  (void)enabled;
+}
+
+// OpenCV stores colour as B, G, R(, A): the channel of `c` on the other side (either way).
+int swap_red_blue(int c, int channels) { return channels >= 3 && c < 3 ? 2 - c : c; }
+
+// Scale from a decoded sample type to [0,1] (floats as they are).
+double sample_scale(const std::string& path, int depth) {
+  switch (depth) {
+    case CV_8U:
+      return 1.0 / 255.0;
+    case CV_16U:
+      return 1.0 / 65535.0;
+    case CV_32F:
+    case CV_64F:
+      return 1.0;
+    default:
+      throw Error(path, "", "unsupported sample type (only 8/16-bit unsigned and float)");
+  }
+}
+
+ImageF to_image(const std::string& path, const cv::Mat& decoded) {
+  const int channels = decoded.channels();
+  const double scale = sample_scale(path, decoded.depth());
+  std::vector<cv::Mat> planes;
+  cv::split(decoded, planes);
+  ImageF image(decoded.cols, decoded.rows, channels);
+  for (int c = 0; c < channels; ++c) {
+    cv::Mat target(image.height(), image.width(), CV_32F, image.plane(c));
+    planes[swap_red_blue(c, channels)].convertTo(target, CV_32F, scale);
+  }
+  return image;
+}
+
+// Interleaved B, G, R(, A) samples of `Sample`, values clamped to [0,1] and rounded to `max`.
+template <class Sample>
+cv::Mat quantise(const std::string& path, const ImageF& image, double max) {
+  const int width = image.width(), height = image.height(), channels = image.channels();
+  cv::Mat samples(height, width, CV_MAKETYPE(cv::DataType<Sample>::depth, channels));
+  for (int c = 0; c < channels; ++c) {
+    const float* plane = image.plane(c);
+    const int k = swap_red_blue(c, channels);
+    for (int y = 0; y < height; ++y) {
+      Sample* row = samples.ptr<Sample>(y);
+      for (int x = 0; x < width; ++x) {
+        const float value = plane[static_cast<std::size_t>(y) * width + x];
+        if (std::isnan(value)) {
+          throw Error(path,
+                      "pixel (" + std::to_string(x) + ", " + std::to_string(y) + "), channel " +
+                          std::to_string(c),
+                      "NaN cannot be written to PNG");
+        }
+        row[x * channels + k] =
+            static_cast<Sample>(std::clamp(static_cast<double>(value), 0.0, 1.0) * max + 0.5);
+      }
+    }
+  }
+  return samples;
+}
+
+cv::Mat interleave_float(const ImageF& image) {
+  const int channels = image.channels();
+  std::vector<cv::Mat> planes(channels);
+  for (int c = 0; c < channels; ++c) {
+    // cv::merge only reads its inputs.
+    planes[swap_red_blue(c, channels)] =
+        cv::Mat(image.height(), image.width(), CV_32F, const_cast<float*>(image.plane(c)));
+  }
+  cv::Mat samples;
+  cv::merge(planes, samples);
+  return samples;
+}
+
+}  // namespace
+
+ImageF read_image(const std::string& path) {
+  enable_openexr();
+  const std::string bytes = read_file_bytes(path);
+  if (bytes.empty()) throw Error(path, "", "the file is empty");
+  cv::Mat decoded;
+  try {
+    const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8U,
+                         const_cast<char*>(bytes.data()));  // imdecode only reads it
+    decoded = cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {
+    throw Error(path, "", "cannot decode the image: " + e.err);
+  }
+  if (decoded.empty()) {
+    throw Error(path, "", "not a readable image (unknown format, corrupt or truncated)");
+  }
+  return to_image(path, decoded);
+}
+
+void write_image(const std::string& path, const ImageF& image, PngDepth depth) {
+  enable_openexr();
+  const std::string extension = lowercase(std::filesystem::path(path).extension().string());
+  if (extension != ".png" && extension != ".exr") {
+    throw Error(path, "", "unknown image extension '" + extension + "' (use .png or .exr)");
+  }
+  if (image.empty()) throw Error(path, "", "the image has no pixels");
+  const int channels = image.channels();
+  if (channels != 1 && channels != 3 && channels != 4) {
+    throw Error(path, "",
+                "cannot write " + std::to_string(channels) + " channels (only 1, 3 or 4)");
+  }
+  cv::Mat samples;
+  std::vector<int> options;
+  if (extension == ".exr") {
+    samples = interleave_float(image);
+    options = {cv::IMWRITE_EXR_TYPE, cv::IMWRITE_EXR_TYPE_FLOAT};
+  } else if (depth == PngDepth::sixteen) {
+    samples = quantise<std::uint16_t>(path, image, 65535.0);
+  } else {
+    samples = quantise<std::uint8_t>(path, image, 255.0);
+  }
+  std::vector<std::uint8_t> encoded;
+  try {
+    if (!cv::imencode(extension, samples, encoded, options)) {
+      throw Error(path, "", "OpenCV could not encode the image");
+    }
+  } catch (const cv::Exception& e) {
+    throw Error(path, "", "cannot encode the image: " + e.err);
+  }
+  AtomicFile file(path);
+  file.stream().write(reinterpret_cast<const char*>(encoded.data()),
+                      static_cast<std::streamsize>(encoded.size()));
+  file.commit();
+}
+
+}  // namespace glint::io
