@@ -81,8 +81,8 @@ std::vector<TestImage> load_images(const EvalOptions& options) {
   }
   if (files.empty()) throw Error(options.data, "", "no images to evaluate");
   for (const std::string& file : files)
-    images.push_back({fs::path(file).stem().string(),
-                      centre_crop(io::read_image(file), options.crop, file)});
+    images.push_back(
+        {fs::path(file).stem().string(), centre_crop(io::read_image(file), options.crop, file)});
   return images;
 }
 
@@ -152,14 +152,16 @@ void run_eval(const EvalOptions& options) {
     record("noisy input", quality(clean, noisy, mask, clean_mask));
 
     ImageF svd_guidance;
-    for (const denoise::NoiseMethod method : {denoise::NoiseMethod::variance, denoise::NoiseMethod::svd}) {
+    for (const denoise::NoiseMethod method :
+         {denoise::NoiseMethod::variance, denoise::NoiseMethod::svd}) {
       denoise::NoiseLevelParams params = guidance_params;
       params.method = method;
       const ImageF level = denoise::noise_level(noisy, params);
       const denoise::Guidance guidance = denoise::guidance_from_noise(level);
       const std::string name = method == denoise::NoiseMethod::svd ? "svd" : "var";
-      record("noise map " + name, {{"auc", denoise::roc_auc(level, mask)},
-                                   {"auc_guidance", denoise::roc_auc(noisiness(guidance.map), mask)}});
+      record("noise map " + name,
+             {{"auc", denoise::roc_auc(level, mask)},
+              {"auc_guidance", denoise::roc_auc(noisiness(guidance.map), mask)}});
       save(options, image.name, "guidance-" + name, guidance.map);
       if (method == guidance_params.method) svd_guidance = guidance.map;
     }
@@ -184,10 +186,11 @@ void run_eval(const EvalOptions& options) {
             if (mask.plane(0)[p] > 0.5f) oracle.plane(c)[p] = run.result.plane(c)[p];
         record("nlm in true mask", quality(clean, oracle, mask, clean_mask));
       }
-      log().info("{} [{}/{}] {:<12} PSNR {:6.2f} (clean {:6.2f}, noisy {:6.2f}) SSIM {:.4f}  {:6.1f} s",
-                 image.name, i + 1, images.size(), method, values["psnr"].get<double>(),
-                 values["psnr_clean"].get<double>(), values["psnr_noisy"].get<double>(),
-                 values["ssim"].get<double>(), run.stats.seconds);
+      log().info(
+          "{} [{}/{}] {:<12} PSNR {:6.2f} (clean {:6.2f}, noisy {:6.2f}) SSIM {:.4f}  {:6.1f} s",
+          image.name, i + 1, images.size(), method, values["psnr"].get<double>(),
+          values["psnr_clean"].get<double>(), values["psnr_noisy"].get<double>(),
+          values["ssim"].get<double>(), run.stats.seconds);
     }
     per_image.push_back(entry);
   }
@@ -206,18 +209,22 @@ void run_eval(const EvalOptions& options) {
                                    : std::string("-");
     };
     fmt::print("{:<18} {:>9} {:>9} {:>9} {:>8} {:>8} {:>9}\n", method, mean("psnr"),
-               mean("psnr_clean"), mean("psnr_noisy"), mean("ssim"), mean("auc"),
-               mean("seconds"));
+               mean("psnr_clean"), mean("psnr_noisy"), mean("ssim"), mean("auc"), mean("seconds"));
   }
   if (!options.report.empty())
     io::write_json(options.report,
                    {{"command", command_line()},
                     {"protocol",
-                     {{"set", options.set}, {"crop", options.crop}, {"sigma_255", options.sigma},
-                      {"coverage", options.coverage}, {"seed", options.protocol_seed},
-                      {"clipped", true}, {"values", "float, as stored (no sRGB decoding)"}}},
+                     {{"set", options.set},
+                      {"crop", options.crop},
+                      {"sigma_255", options.sigma},
+                      {"coverage", options.coverage},
+                      {"seed", options.protocol_seed},
+                      {"clipped", true},
+                      {"values", "float, as stored (no sRGB decoding)"}}},
                     {"config", options.denoiser.config},
-                    {"guidance", options.oracle_guidance ? "oracle (true mask)" : options.denoiser.noise_method},
+                    {"guidance", options.oracle_guidance ? "oracle (true mask)"
+                                                         : options.denoiser.noise_method},
                     {"denoiser_seed", options.denoiser.seed},
                     {"images", per_image},
                     {"summary", summary}});
@@ -237,9 +244,10 @@ void register_denoise_eval(CLI::App& denoise) {
       "part and the noisy part (PSNR, SSIM), with runtimes; mean/median/min/max over images.");
   command->add_option("--images", options->images, "Clean images (default: the --set folder)");
   command->add_option("--data", options->data, "Data folder ($GLINT_DATA)")->capture_default_str();
-  command->add_option("--set", options->set,
-                      "Folder under <data>/images (kodak, skimage, ...) or 'patterns' (procedural "
-                      "steps and gradients)")
+  command
+      ->add_option("--set", options->set,
+                   "Folder under <data>/images (kodak, skimage, ...) or 'patterns' (procedural "
+                   "steps and gradients)")
       ->capture_default_str();
   command->add_option("--count", options->count, "Images: the first N of the set")
       ->check(CLI::PositiveNumber)
@@ -259,8 +267,8 @@ void register_denoise_eval(CLI::App& denoise) {
   command->add_option("--protocol-seed", options->protocol_seed, "Seed of the blobs and noise")
       ->capture_default_str();
   command->add_flag("--oracle-guidance", options->oracle_guidance,
-                   "Guide with the true clean mask instead of the estimated map (an upper bound "
-                   "that separates the method from the noise-map quality)");
+                    "Guide with the true clean mask instead of the estimated map (an upper bound "
+                    "that separates the method from the noise-map quality)");
   command->add_option("--save", options->save, "Folder for clean/noisy/mask/guidance/results");
   command->add_option("--report", options->report, "JSON report (per image and summary)");
   options->denoiser.add_options(*command);

@@ -48,16 +48,15 @@ void run_noise_map(const NoiseMapOptions& options) {
              options.input, image.width(), image.height(), image.channels(), options.method,
              options.patch, guidance.n_peak, guidance.lower, guidance.upper, options.output);
   if (!options.report.empty())
-    io::write_json(options.report,
-                   {{"command", command_line()},
-                    {"input", options.input},
-                    {"size", {image.width(), image.height(), image.channels()}},
-                    {"method", options.method},
-                    {"patch", options.patch},
-                    {"n_peak", guidance.n_peak},
-                    {"lower", guidance.lower},
-                    {"upper", guidance.upper},
-                    {"timings_ms", timings.to_json()}});
+    io::write_json(options.report, {{"command", command_line()},
+                                    {"input", options.input},
+                                    {"size", {image.width(), image.height(), image.channels()}},
+                                    {"method", options.method},
+                                    {"patch", options.patch},
+                                    {"n_peak", guidance.n_peak},
+                                    {"lower", guidance.lower},
+                                    {"upper", guidance.upper},
+                                    {"timings_ms", timings.to_json()}});
 }
 
 }  // namespace
@@ -83,8 +82,9 @@ void register_denoise_noise_map(CLI::App& denoise) {
   command->add_option("--bins", options->guidance.bins, "Histogram bins for the remapping")
       ->check(CLI::Range(8, 65536))
       ->capture_default_str();
-  command->add_option("--upper-quantile", options->guidance.upper_quantile,
-                      "Noise-level quantile that maps to 0")
+  command
+      ->add_option("--upper-quantile", options->guidance.upper_quantile,
+                   "Noise-level quantile that maps to 0")
       ->check(CLI::Range(0.5, 1.0))
       ->capture_default_str();
   command->add_option("--raw", options->raw, "Also write the raw noise level (EXR recommended)");

@@ -40,9 +40,9 @@ void run_denoise(const RunOptions& options) {
       if (guidance.channels() != 1)
         throw Error(options.guidance, "", "guidance map must have one channel");
     } else {
-      guidance = denoise::guidance_from_noise(
-                     denoise::noise_level(noisy, options.denoiser.noise_params()))
-                     .map;
+      guidance =
+          denoise::guidance_from_noise(denoise::noise_level(noisy, options.denoiser.noise_params()))
+              .map;
     }
     if (!options.save_guidance.empty())
       io::write_image(options.save_guidance, guidance, io::PngDepth::sixteen);
@@ -60,8 +60,8 @@ void run_denoise(const RunOptions& options) {
     };
   }
   const DenoiseRun run =
-      run_denoiser(options.method, options.denoiser, noisy,
-                   guidance.empty() ? nullptr : &guidance, snapshot, options.snapshot_every);
+      run_denoiser(options.method, options.denoiser, noisy, guidance.empty() ? nullptr : &guidance,
+                   snapshot, options.snapshot_every);
   io::write_image(options.output, run.result, depth);
   log().info("{}: {} on {}, {} iterations, {:.1f} s -> {}", options.input, options.method,
              run.stats.device, run.stats.iterations, run.stats.seconds, options.output);
@@ -89,10 +89,8 @@ void register_denoise_run(CLI::App& denoise) {
       "(eqs 15-16); guided-s2s lets the network see and fit important pixels and masks the\n"
       "others (eqs 17-24). Without --guidance the map is estimated from the input (SVD).\n"
       "Any channel count; values as stored in the file.");
-  command->add_option("input", options->input, "Noisy image (PNG 8/16-bit, EXR, ...)")
-      ->required();
-  command->add_option("-o,--output", options->output, "Denoised image (.png or .exr)")
-      ->required();
+  command->add_option("input", options->input, "Noisy image (PNG 8/16-bit, EXR, ...)")->required();
+  command->add_option("-o,--output", options->output, "Denoised image (.png or .exr)")->required();
   command->add_option("--method", options->method, "guided-s2s, s2s, guided-dip, dip or nlm")
       ->check(CLI::IsMember(denoise_method_names()))
       ->capture_default_str();
@@ -100,8 +98,9 @@ void register_denoise_run(CLI::App& denoise) {
                       "Guidance map (one channel, the image's size; from 'noise-map')");
   command->add_option("--save-guidance", options->save_guidance,
                       "Write the guidance map used (estimated or given)");
-  command->add_option("--snapshot-every", options->snapshot_every,
-                      "Write the current estimate every N iterations")
+  command
+      ->add_option("--snapshot-every", options->snapshot_every,
+                   "Write the current estimate every N iterations")
       ->check(CLI::NonNegativeNumber);
   command->add_option("--snapshot-dir", options->snapshot_dir, "Folder for the snapshots")
       ->default_str("snapshots");

@@ -43,7 +43,7 @@ edges::Model train_in_plugin(const edges::TrainingSet& set, const edges::ModelCo
   call.params = &params;
   call.quiet = is_quiet();
   call.result = &model;
-  if (entry(&call) != 0) throw Error(call.error_file, call.error_element, call.error_reason);
+  if (entry(&call) != 0) call.failure.rethrow();
   return model;
 }
 

@@ -67,8 +67,8 @@ nlohmann::json neural_speed(denoise::NeuralMethod method, const std::string& con
         (predicting.seconds - training.seconds / iterations) / iterations;
     entry["preset_predictions"] = denoise::neural_preset(method, config).predictions;
   }
-  const double predictions_cost = entry.value("seconds_per_prediction", 0.0) *
-                                  entry.value("preset_predictions", 0);
+  const double predictions_cost =
+      entry.value("seconds_per_prediction", 0.0) * entry.value("preset_predictions", 0);
   entry["estimated_seconds_per_image"] =
       entry["seconds_per_iteration"].get<double>() * entry["preset_iterations"].get<int>() +
       predictions_cost;
@@ -82,12 +82,17 @@ int main(int argc, char** argv) {
   std::string json_path;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i];
-    if (flag == "--size") size = std::stoi(argv[i + 1]);
-    else if (flag == "--net-size") net_size = std::stoi(argv[i + 1]);
-    else if (flag == "--full-iterations") full_iterations = std::stoi(argv[i + 1]);
-    else if (flag == "--json") json_path = argv[i + 1];
+    if (flag == "--size")
+      size = std::stoi(argv[i + 1]);
+    else if (flag == "--net-size")
+      net_size = std::stoi(argv[i + 1]);
+    else if (flag == "--full-iterations")
+      full_iterations = std::stoi(argv[i + 1]);
+    else if (flag == "--json")
+      json_path = argv[i + 1];
     else {
-      std::cerr << "usage: denoise_speed [--size N] [--net-size N] [--full-iterations N] [--json F]\n";
+      std::cerr
+          << "usage: denoise_speed [--size N] [--net-size N] [--full-iterations N] [--json F]\n";
       return 2;
     }
   }
@@ -100,10 +105,15 @@ int main(int argc, char** argv) {
     ImageF level;
     const double seconds = median_seconds(5, [&] { level = denoise::noise_level(big, params); });
     const double remap = median_seconds(5, [&] { denoise::guidance_from_noise(level); });
-    result["noise_level"].push_back({{"method", method == denoise::NoiseMethod::svd ? "svd" : "var"},
-                                     {"width", size}, {"height", size}, {"channels", 3},
-                                     {"patch", 7}, {"seconds", seconds}, {"remap_seconds", remap},
-                                     {"megapixels_per_second", size * size / seconds / 1e6}});
+    result["noise_level"].push_back(
+        {{"method", method == denoise::NoiseMethod::svd ? "svd" : "var"},
+         {"width", size},
+         {"height", size},
+         {"channels", 3},
+         {"patch", 7},
+         {"seconds", seconds},
+         {"remap_seconds", remap},
+         {"megapixels_per_second", size * size / seconds / 1e6}});
   }
 
   const ImageF small = noisy_test_image(net_size);
@@ -119,7 +129,9 @@ int main(int argc, char** argv) {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   result["peak_rss_mib"] = usage.ru_maxrss / 1024;
-  if (json_path.empty()) std::cout << result.dump(2) << "\n";
-  else io::write_json(json_path, result);
+  if (json_path.empty())
+    std::cout << result.dump(2) << "\n";
+  else
+    io::write_json(json_path, result);
   return 0;
 }

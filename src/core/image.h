@@ -12,7 +12,9 @@ class Image {
  public:
   Image() = default;
   Image(int width, int height, int channels, T fill = T{})
-      : width_(width), height_(height), channels_(channels),
+      : width_(width),
+        height_(height),
+        channels_(channels),
         data_(static_cast<std::size_t>(width) * height * channels, fill) {}
 
   int width() const { return width_; }
@@ -29,9 +31,7 @@ class Image {
 
   // The c-th channel plane: pixel_count() values, row-major.
   T* plane(int c) { return data_.data() + static_cast<std::size_t>(c) * pixel_count(); }
-  const T* plane(int c) const {
-    return data_.data() + static_cast<std::size_t>(c) * pixel_count();
-  }
+  const T* plane(int c) const { return data_.data() + static_cast<std::size_t>(c) * pixel_count(); }
 
   std::vector<T>& values() { return data_; }
   const std::vector<T>& values() const { return data_; }

@@ -39,8 +39,7 @@ ImageF denoise_neural(const ImageF& noisy, const ImageF* guidance, const NeuralP
   local.device = device.str();
   ImageF result = is_self2self(params.method) ? run_self2self(input, guide, params, local)
                                               : run_dip(input, guide, params, local);
-  local.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  local.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (stats) *stats = local;
   return result;
 }

@@ -4,6 +4,7 @@
 // Tests link glint_denoise_nets directly.
 #include <string>
 
+#include "core/plugin_call.h"
 #include "denoise/neural.h"
 
 namespace glint::denoise {
@@ -15,8 +16,7 @@ struct DenoisePluginCall {
   bool quiet = false;  // the module has its own copy of the progress-bar switch
   ImageF* result = nullptr;
   NeuralStats* stats = nullptr;
-  // Set on failure (glint::Error's parts; nothing is thrown across the module boundary).
-  std::string error_file, error_element, error_reason;
+  PluginFailure failure;  // set when the call returns 1
 };
 
 // extern "C" entry point of the module: 0 on success, 1 on failure.

@@ -33,8 +33,8 @@ ImageF run_dip(const torch::Tensor& noisy, const torch::Tensor& guidance,
     if (decay_base.defined() && i >= params.decay.warmup) {
       // eq. (16): w = base^((i − κw)·κr)·(1 − κc) + κc; eq. (15): mean of (residual·w)².
       const double exponent = (i - params.decay.warmup) * params.decay.rate;
-      residual = residual * (decay_base.pow(exponent) * (1.0 - params.decay.floor) +
-                             params.decay.floor);
+      residual =
+          residual * (decay_base.pow(exponent) * (1.0 - params.decay.floor) + params.decay.floor);
     }
     residual.pow(2).mean().backward();
     optimiser.step();

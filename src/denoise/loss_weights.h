@@ -5,9 +5,9 @@
 namespace glint::denoise {
 
 struct DecayParams {
-  int warmup = 225;      // κw: iterations with full weight
-  double rate = 0.15;    // κr
-  double floor = 0.02;   // κc: the weight converges to this, never to 0
+  int warmup = 225;     // κw: iterations with full weight
+  double rate = 0.15;   // κr
+  double floor = 0.02;  // κc: the weight converges to this, never to 0
 };
 
 // w_dec at iteration i for a pixel of importance m ∈ [0,1]: 1 during warm-up, then

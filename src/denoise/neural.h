@@ -29,24 +29,24 @@ struct UNetConfig {
 struct NeuralParams {
   NeuralMethod method = NeuralMethod::guided_s2s;
   UNetConfig net;
-  int iterations = 3000;          // optimisation steps
-  double learning_rate = 0.01;    // Adam
+  int iterations = 3000;        // optimisation steps
+  double learning_rate = 0.01;  // Adam
   // Deep Image Prior (§3.2).
-  int input_channels = 32;        // fixed input U[0, input_scale]
+  int input_channels = 32;  // fixed input U[0, input_scale]
   double input_scale = 0.1;
   double input_perturbation = 1.0 / 30.0;  // σ of the per-iteration input noise
-  double averaging = 0.99;        // output EMA, eq. (14)
-  DecayParams decay;              // guided loss weights, eq. (16)
+  double averaging = 0.99;                 // output EMA, eq. (14)
+  DecayParams decay;                       // guided loss weights, eq. (16)
   // Self2Self (§3.3).
   MaskParams masks;
-  double dropout = 0.3;           // decoder dropout rate before eq. (24)'s modulation
-  int predictions = 100;          // test-time dropout samples averaged
-  bool flips = true;              // random left-right / up-down flips of each sample
+  double dropout = 0.3;   // decoder dropout rate before eq. (24)'s modulation
+  int predictions = 100;  // test-time dropout samples averaged
+  bool flips = true;      // random left-right / up-down flips of each sample
   // Run control.
   std::uint64_t seed = 1;
-  std::string device = "auto";    // auto | cpu | cuda
-  int threads = 0;                // intra-op threads on the CPU (0 = libtorch's default)
-  int snapshot_every = 0;         // call `snapshot` every N iterations (0 = never)
+  std::string device = "auto";  // auto | cpu | cuda
+  int threads = 0;              // intra-op threads on the CPU (0 = libtorch's default)
+  int snapshot_every = 0;       // call `snapshot` every N iterations (0 = never)
   std::function<void(int iteration, const ImageF& estimate)> snapshot;
 };
 

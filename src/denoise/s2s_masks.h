@@ -7,9 +7,9 @@
 namespace glint::denoise {
 
 struct MaskParams {
-  double keep = 0.7;       // p_m: probability an unimportant pixel is in the network input
-  double discard = 0.01;   // p_d: scales both masks down for unimportant pixels
-  double exponent = 2.0;   // κm
+  double keep = 0.7;      // p_m: probability an unimportant pixel is in the network input
+  double discard = 0.01;  // p_d: scales both masks down for unimportant pixels
+  double exponent = 2.0;  // κm
 };
 
 // p_imp = m^κm, eq. (19).

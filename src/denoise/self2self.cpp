@@ -48,8 +48,8 @@ MaskModel make_mask_model(const torch::Tensor& guidance, int64_t height, int64_t
   model.input_below = map_tensor(input, height, width, device);
   model.target_below = map_tensor(target, height, width, device);
   // Decoder level l runs at 1/2^l resolution: average the padded full-resolution rates.
-  const torch::Tensor full = pad_to_multiple(map_tensor(rate, height, width, device),
-                                             1 << params.net.levels);
+  const torch::Tensor full =
+      pad_to_multiple(map_tensor(rate, height, width, device), 1 << params.net.levels);
   for (int l = 0; l < params.net.levels; ++l)
     model.drop_rates.push_back(l == 0 ? full : torch::avg_pool2d(full, 1 << l));
   return model;
@@ -62,8 +62,7 @@ SampledMasks sample_masks(const torch::Tensor& both_below, const torch::Tensor& 
   const torch::Tensor u = torch::rand_like(both_below);
   SampledMasks masks;
   masks.input = (u < input_below).to(torch::kFloat32);
-  masks.target =
-      ((u < both_below) | ((u >= input_below) & (u < target_below))).to(torch::kFloat32);
+  masks.target = ((u < both_below) | ((u >= input_below) & (u < target_below))).to(torch::kFloat32);
   return masks;
 }
 

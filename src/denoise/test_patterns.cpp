@@ -35,8 +35,8 @@ ImageF step_gradient_pattern(int width, int height, int channels, std::uint64_t 
         const float u = static_cast<float>(x) / width, v = static_cast<float>(y) / height;
         if (!inside(u, v)) continue;
         for (int c = 0; c < channels; ++c)
-          image.at(x, y, c) =
-              std::clamp(fill.base[c] + fill.gx[c] * (u - 0.5f) + fill.gy[c] * (v - 0.5f), 0.f, 1.f);
+          image.at(x, y, c) = std::clamp(
+              fill.base[c] + fill.gx[c] * (u - 0.5f) + fill.gy[c] * (v - 0.5f), 0.f, 1.f);
       }
   };
   paint(random_fill(random, channels, true), [](float, float) { return true; });

@@ -26,7 +26,8 @@ ImageF to_image(const torch::Tensor& tensor) {
   const torch::Tensor first = tensor[0].detach().to(torch::kCPU, torch::kFloat32).contiguous();
   ImageF image(static_cast<int>(first.size(2)), static_cast<int>(first.size(1)),
                static_cast<int>(first.size(0)));
-  std::memcpy(image.values().data(), first.data_ptr<float>(), image.values().size() * sizeof(float));
+  std::memcpy(image.values().data(), first.data_ptr<float>(),
+              image.values().size() * sizeof(float));
   return image;
 }
 

@@ -51,15 +51,17 @@ UNetImpl::UNetImpl(int in_channels, int out_channels, const UNetConfig& config) 
     if (config.skip_channels > 0)
       skip_.push_back(register_module("skip" + std::to_string(l),
                                       conv_norm_act(level_in, config.skip_channels, 1, 1)));
-    up_.push_back(register_module("up" + std::to_string(l),
-                                  UpBlock(config.skip_channels + config.channels, config.channels)));
+    up_.push_back(
+        register_module("up" + std::to_string(l),
+                        UpBlock(config.skip_channels + config.channels, config.channels)));
     level_in = config.channels;
   }
-  output_ = register_module(
-      "output", nn::Conv2d(nn::Conv2dOptions(config.channels, out_channels, 1)));
+  output_ =
+      register_module("output", nn::Conv2d(nn::Conv2dOptions(config.channels, out_channels, 1)));
 }
 
-torch::Tensor UNetImpl::forward(const torch::Tensor& x, const std::vector<torch::Tensor>& drop_rates) {
+torch::Tensor UNetImpl::forward(const torch::Tensor& x,
+                                const std::vector<torch::Tensor>& drop_rates) {
   std::vector<torch::Tensor> skips;
   torch::Tensor y = x;
   for (int l = 0; l < levels(); ++l) {

@@ -5,6 +5,7 @@
 // code directly (glint_edges_train).
 #include <string>
 
+#include "core/plugin_call.h"
 #include "edges/train.h"
 
 namespace glint::edges {
@@ -15,9 +16,7 @@ struct TrainPluginCall {
   const TrainParams* params = nullptr;
   bool quiet = false;  // the module has its own copy of the progress-bar switch
   Model* result = nullptr;
-  // Set when training fails (the module reports glint::Error's parts instead of throwing
-  // across the module boundary).
-  std::string error_file, error_element, error_reason;
+  PluginFailure failure;  // set when the call returns 1
 };
 
 // extern "C" entry point of the module: 0 on success, 1 on failure.

@@ -29,9 +29,9 @@ class DenoiseCliTest : public CliTest {
 };
 
 TEST_F(DenoiseCliTest, NoiseMapRunAndEval) {
-  const CommandResult map = glint("denoise noise-map " + path("noisy.png") + " -o " +
-                                  path("m.png") + " --raw " + path("n.exr") + " --report " +
-                                  path("map.json"));
+  const CommandResult map =
+      glint("denoise noise-map " + path("noisy.png") + " -o " + path("m.png") + " --raw " +
+            path("n.exr") + " --report " + path("map.json"));
   ASSERT_EQ(map.exit_code, 0) << map.output;
   const ImageF guidance = io::read_image(path("m.png"));
   EXPECT_EQ(guidance.width(), 48);
@@ -82,8 +82,8 @@ TEST_F(DenoiseCliTest, BadInputsGiveOneLineErrors) {
   EXPECT_NE(mismatch.output.find("20x20"), std::string::npos) << mismatch.output;
   EXPECT_FALSE(fs::exists(path("out.png")));
 
-  const CommandResult missing = glint("denoise noise-map " + path("nope.png") + " -o " +
-                                      path("m.png"));
+  const CommandResult missing =
+      glint("denoise noise-map " + path("nope.png") + " -o " + path("m.png"));
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.output.find("nope.png"), std::string::npos) << missing.output;
   EXPECT_FALSE(fs::exists(path("m.png")));

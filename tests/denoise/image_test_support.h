@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/image.h"
+#include "support/error_of.h"
 
 namespace glint::denoise::test {
 
@@ -34,16 +35,6 @@ inline ImageF box_mask(int width, int height, int x0, int y0, int x1, int y1) {
   return mask;
 }
 
-// The glint::Error that `action` throws (a test failure when it throws none).
-template <class Action>
-Error error_of(Action&& action) {
-  try {
-    action();
-  } catch (const Error& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no glint::Error was thrown";
-  return Error("", "", "no error");
-}
+using glint::test::error_of;
 
 }  // namespace glint::denoise::test

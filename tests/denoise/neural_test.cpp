@@ -1,6 +1,8 @@
 // The neural denoisers: eq. (16)'s loss-weight schedule, eqs (17)-(24)'s mask and dropout
 // probabilities (analytic and sampled), the U-Net's shapes, and few-iteration runs of each
 // method on a 32×32 image.
+#include "denoise/neural.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -8,7 +10,6 @@
 #include <random>
 
 #include "core/error.h"
-#include "denoise/neural.h"
 #include "denoise/neural_impl.h"
 #include "denoise/torch_support.h"
 #include "denoise/unet.h"
@@ -47,9 +48,9 @@ TEST(MaskProbabilities, SumToOneAndInterpolate) {
     EXPECT_DOUBLE_EQ(p_imp, m * m);
     const MaskProbabilities q = mask_probabilities(p_imp, p);
     EXPECT_NEAR(q.both + q.input_only + q.target_only + q.neither, 1.0, 1e-12);
-    EXPECT_DOUBLE_EQ(q.both, p_imp);                                  // eq. (20)
-    EXPECT_NEAR(q.input_only, 0.7 * 0.01 * (1 - p_imp), 1e-15);       // eq. (21)
-    EXPECT_NEAR(q.target_only, 0.3 * 0.01 * (1 - p_imp), 1e-15);      // eq. (22)
+    EXPECT_DOUBLE_EQ(q.both, p_imp);                              // eq. (20)
+    EXPECT_NEAR(q.input_only, 0.7 * 0.01 * (1 - p_imp), 1e-15);   // eq. (21)
+    EXPECT_NEAR(q.target_only, 0.3 * 0.01 * (1 - p_imp), 1e-15);  // eq. (22)
     // eqs (17)-(18): marginals.
     EXPECT_NEAR(q.both + q.input_only, p_imp + (1 - p_imp) * 0.7 * 0.01, 1e-15);
     EXPECT_NEAR(q.both + q.target_only, p_imp + (1 - p_imp) * 0.3 * 0.01, 1e-15);

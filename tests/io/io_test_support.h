@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "support/error_of.h"
 
 namespace glint::io::test {
 
@@ -49,16 +50,6 @@ inline std::string read_text(const std::string& path) {
   return {std::istreambuf_iterator<char>(stream), {}};
 }
 
-// The glint::Error that `action` throws (a test failure when it throws none).
-template <class Action>
-Error error_of(Action&& action) {
-  try {
-    action();
-  } catch (const Error& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no glint::Error was thrown";
-  return Error("", "", "no error");
-}
+using glint::test::error_of;
 
 }  // namespace glint::io::test
