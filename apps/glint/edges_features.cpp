@@ -4,12 +4,12 @@
 #include <array>
 #include <filesystem>
 #include <memory>
-#include <sstream>
 
 #include "commands.h"
 #include "core/error.h"
 #include "edges/features.h"
 #include "io/atomic_file.h"
+#include "io/npy.h"
 #include "io/point_cloud_io.h"
 
 namespace glint::app {
@@ -24,27 +24,6 @@ struct FeaturesOptions {
 constexpr std::array<const char*, edges::kFeaturesPerScale> kFeatureNames = {
     "sigma_upper1", "sigma_upper2", "sigma_upper3", "sigma_lower1", "sigma_lower2", "sigma_lower3",
     "d_perp",       "d_parallel",   "s_perp",       "s_parallel",   "c_perp",       "c_parallel"};
-
-// NumPy .npy v1.0: float32, C order, shape (points, scales * 12).
-void write_npy(const std::string& path, const edges::FeatureMatrix& features) {
-  std::ostringstream dict;
-  dict << "{'descr': '<f4', 'fortran_order': False, 'shape': (" << features.points << ", "
-       << features.row_size() << "), }";
-  std::string header = dict.str();
-  const std::size_t unpadded = 10 + header.size() + 1;
-  header.append((64 - unpadded % 64) % 64, ' ');
-  header += '\n';
-  io::AtomicFile file(path);
-  std::ostream& out = file.stream();
-  out.write("\x93NUMPY\x01\x00", 8);
-  const auto length = static_cast<std::uint16_t>(header.size());
-  const char length_bytes[2] = {char(length & 0xff), char(length >> 8)};
-  out.write(length_bytes, 2);
-  out << header;
-  out.write(reinterpret_cast<const char*>(features.values.data()),
-            std::streamsize(features.values.size() * sizeof(float)));
-  file.commit();
-}
 
 void write_csv(const std::string& path, const edges::FeatureMatrix& features,
                const std::vector<int>& scales) {
@@ -79,7 +58,8 @@ void run_features(const FeaturesOptions& options) {
     throw Error(options.input, e.element(), e.reason());
   }
   if (extension == ".npy") {
-    write_npy(options.output, features);
+    io::write_npy(options.output, {features.points, features.row_size()},
+                  features.values.data());
   } else {
     write_csv(options.output, features, options.scales);
   }

@@ -12,6 +12,7 @@
 #include "io/atomic_file.h"
 #include "io/codec.h"
 #include "io/file_bytes.h"
+#include "io/npy.h"
 
 namespace glint::io {
 namespace {
@@ -93,9 +94,39 @@ cv::Mat interleave_float(const ImageF& image) {
   return samples;
 }
 
+// .npy images are (height, width) or (height, width, channels), the NumPy convention.
+ImageF read_npy_image(const std::string& path) {
+  const NpyArray array = read_npy(path);
+  if (array.shape.size() != 2 && array.shape.size() != 3)
+    throw Error(path, "", "an image array must be (height, width) or (height, width, channels)");
+  const std::size_t channels = array.shape.size() == 3 ? array.shape[2] : 1;
+  if (array.values.empty()) throw Error(path, "", "the image has no pixels");
+  ImageF image(static_cast<int>(array.shape[1]), static_cast<int>(array.shape[0]),
+               static_cast<int>(channels));
+  const std::size_t pixels = image.pixel_count();
+  for (std::size_t c = 0; c < channels; ++c)
+    for (std::size_t p = 0; p < pixels; ++p)
+      image.plane(static_cast<int>(c))[p] = array.values[p * channels + c];
+  return image;
+}
+
+void write_npy_image(const std::string& path, const ImageF& image) {
+  const auto channels = static_cast<std::size_t>(image.channels());
+  std::vector<float> interleaved(image.values().size());
+  for (std::size_t c = 0; c < channels; ++c)
+    for (std::size_t p = 0; p < image.pixel_count(); ++p)
+      interleaved[p * channels + c] = image.plane(static_cast<int>(c))[p];
+  std::vector<std::size_t> shape{static_cast<std::size_t>(image.height()),
+                                 static_cast<std::size_t>(image.width())};
+  if (channels > 1) shape.push_back(channels);
+  write_npy(path, shape, interleaved.data());
+}
+
 }  // namespace
 
 ImageF read_image(const std::string& path) {
+  if (lowercase(std::filesystem::path(path).extension().string()) == ".npy")
+    return read_npy_image(path);
   enable_openexr();
   const std::string bytes = read_file_bytes(path);
   if (bytes.empty()) throw Error(path, "", "the file is empty");
@@ -116,14 +147,17 @@ ImageF read_image(const std::string& path) {
 void write_image(const std::string& path, const ImageF& image, PngDepth depth) {
   enable_openexr();
   const std::string extension = lowercase(std::filesystem::path(path).extension().string());
-  if (extension != ".png" && extension != ".exr") {
-    throw Error(path, "", "unknown image extension '" + extension + "' (use .png or .exr)");
+  if (extension != ".png" && extension != ".exr" && extension != ".npy") {
+    throw Error(path, "",
+                "unknown image extension '" + extension + "' (use .png, .exr or .npy)");
   }
   if (image.empty()) throw Error(path, "", "the image has no pixels");
+  if (extension == ".npy") return write_npy_image(path, image);
   const int channels = image.channels();
   if (channels != 1 && channels != 3 && channels != 4) {
     throw Error(path, "",
-                "cannot write " + std::to_string(channels) + " channels (only 1, 3 or 4)");
+                "cannot write " + std::to_string(channels) +
+                    " channels as PNG or EXR (1, 3 or 4; use .npy for any count)");
   }
   cv::Mat samples;
   std::vector<int> options;
