@@ -22,7 +22,7 @@ void DenoiserOptions::add_options(CLI::App& command) {
   command
       .add_option("--config", config,
                   "full = the paper's settings (5 levels x 128 filters; GPU-sized), fast = "
-                  "CPU-practical (4 x 16, 800-900 iterations)")
+                  "CPU-practical (4 x 16, 800 iterations)")
       ->check(CLI::IsMember({"full", "fast"}))
       ->capture_default_str();
   command.add_option("--device", device, "auto (CUDA when available), cpu or cuda")

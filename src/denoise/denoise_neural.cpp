@@ -1,6 +1,8 @@
 // denoise_neural(): checks the inputs, sets up libtorch (seed, device, threads) and runs DIP or
 // Self2Self.
+#include <algorithm>
 #include <chrono>
+#include <thread>
 
 #include "core/error.h"
 #include "denoise/neural_impl.h"
@@ -29,7 +31,9 @@ ImageF denoise_neural(const ImageF& noisy, const ImageF* guidance, const NeuralP
 
   const auto start = std::chrono::steady_clock::now();
   torch::manual_seed(params.seed);
-  if (params.threads > 0) torch::set_num_threads(params.threads);
+  // libtorch's CPU default can be a single intra-op thread; use every core unless told.
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  torch::set_num_threads(params.threads > 0 ? params.threads : static_cast<int>(cores));
   const torch::Device device = resolve_device(params.device);
   const torch::Tensor input = to_tensor(noisy, device);
   const torch::Tensor guide =

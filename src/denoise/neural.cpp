@@ -50,7 +50,7 @@ NeuralParams neural_preset(NeuralMethod method, const std::string& config) {
     // Sized so a 256×256 colour image takes under two minutes on two CPU cores (chosen on
     // skimage crops, never on the Kodak evaluation images).
     p.net = UNetConfig{4, 16, 4};
-    p.iterations = s2s ? 800 : 900;
+    p.iterations = 800;
     p.learning_rate = s2s ? 2e-3 : 0.01;
     p.predictions = 50;
     // p_d = 1, as the paper used for natural images (Fig. 9): with p_d = 0.01 a noisy pixel is

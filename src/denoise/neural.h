@@ -45,7 +45,7 @@ struct NeuralParams {
   // Run control.
   std::uint64_t seed = 1;
   std::string device = "auto";  // auto | cpu | cuda
-  int threads = 0;              // intra-op threads on the CPU (0 = libtorch's default)
+  int threads = 0;              // intra-op threads on the CPU (0 = every core)
   int snapshot_every = 0;       // call `snapshot` every N iterations (0 = never)
   std::function<void(int iteration, const ImageF& estimate)> snapshot;
 };
