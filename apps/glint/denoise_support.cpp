@@ -1,5 +1,7 @@
 #include "denoise_support.h"
 
+#include <tbb/global_control.h>
+
 #include <chrono>
 
 #include "core/error.h"
@@ -69,6 +71,9 @@ denoise::NeuralParams DenoiserOptions::neural_params(denoise::NeuralMethod metho
   denoise::NeuralParams p = denoise::neural_preset(method, config);
   p.device = device;
   p.seed = seed;
+  // The global --threads limit (TBB's) also bounds libtorch's intra-op threads.
+  p.threads = static_cast<int>(
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
   if (iterations) p.iterations = *iterations;
   if (predictions) p.predictions = *predictions;
   if (levels) p.net.levels = *levels;
