@@ -58,8 +58,7 @@ void run_features(const FeaturesOptions& options) {
     throw Error(options.input, e.element(), e.reason());
   }
   if (extension == ".npy") {
-    io::write_npy(options.output, {features.points, features.row_size()},
-                  features.values.data());
+    io::write_npy(options.output, {features.points, features.row_size()}, features.values.data());
   } else {
     write_csv(options.output, features, options.scales);
   }

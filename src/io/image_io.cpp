@@ -148,8 +148,7 @@ void write_image(const std::string& path, const ImageF& image, PngDepth depth) {
   enable_openexr();
   const std::string extension = lowercase(std::filesystem::path(path).extension().string());
   if (extension != ".png" && extension != ".exr" && extension != ".npy") {
-    throw Error(path, "",
-                "unknown image extension '" + extension + "' (use .png, .exr or .npy)");
+    throw Error(path, "", "unknown image extension '" + extension + "' (use .png, .exr or .npy)");
   }
   if (image.empty()) throw Error(path, "", "the image has no pixels");
   if (extension == ".npy") return write_npy_image(path, image);

@@ -79,9 +79,9 @@ NpyArray read_npy(const std::string& path) {
   }
   const std::size_t element = is_f4 ? 4 : 8;
   if (bytes.size() - data_start < count * element)
-    throw Error(path, "", "truncated: the shape needs " + std::to_string(count * element) +
-                              " data bytes, the file has " +
-                              std::to_string(bytes.size() - data_start));
+    throw Error(path, "",
+                "truncated: the shape needs " + std::to_string(count * element) +
+                    " data bytes, the file has " + std::to_string(bytes.size() - data_start));
   array.values.resize(count);
   const char* data = bytes.data() + data_start;
   if (is_f4) {

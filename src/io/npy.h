@@ -13,8 +13,7 @@ struct NpyArray {
 };
 
 // Writes float32 little-endian; atomic (temporary + rename). Throws glint::Error naming `path`.
-void write_npy(const std::string& path, const std::vector<std::size_t>& shape,
-               const float* values);
+void write_npy(const std::string& path, const std::vector<std::size_t>& shape, const float* values);
 
 // Reads '<f4' or '<f8' (converted to float), C order. A truncated file, another dtype, Fortran
 // order or a malformed header -> glint::Error naming `path` and the problem.

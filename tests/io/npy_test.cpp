@@ -81,7 +81,7 @@ TEST(NpyImage, FiveChannelMaterialMapRoundTrips) {
   const std::string path = scratch("material.npy");
   write_image(path, image);
   const NpyArray raw = read_npy(path);
-  EXPECT_EQ(raw.shape, (std::vector<std::size_t>{3, 4, 5}));      // (height, width, channels)
+  EXPECT_EQ(raw.shape, (std::vector<std::size_t>{3, 4, 5}));  // (height, width, channels)
   EXPECT_FLOAT_EQ(raw.values[(2 * 4 + 1) * 5 + 3], image.at(1, 2, 3));
   const ImageF back = read_image(path);
   EXPECT_EQ(back.channels(), 5);
