@@ -86,17 +86,12 @@ std::vector<TestImage> load_images(const EvalOptions& options) {
   return images;
 }
 
-ImageF complement(const ImageF& mask) {
-  ImageF inverse = mask;
-  for (float& v : inverse.values()) v = v > 0.5f ? 0.f : 1.f;
+// 1 − v: the clean part of a 0/1 noise mask, or a guidance map as noisiness (high = noisy,
+// like the raw levels).
+ImageF inverted(const ImageF& image) {
+  ImageF inverse = image;
+  for (float& v : inverse.values()) v = 1.f - v;
   return inverse;
-}
-
-// 1 − m, so that high means noisy like the raw levels.
-ImageF noisiness(const ImageF& guidance) {
-  ImageF n = guidance;
-  for (float& v : n.values()) v = 1.f - v;
-  return n;
 }
 
 nlohmann::json quality(const ImageF& clean, const ImageF& result, const ImageF& noisy_mask,
@@ -139,7 +134,7 @@ void run_eval(const EvalOptions& options) {
     const ImageF& clean = image.clean;
     const ImageF mask = denoise::blob_mask(clean.width(), clean.height(), options.coverage,
                                            options.protocol_seed + i);
-    const ImageF clean_mask = complement(mask);
+    const ImageF clean_mask = inverted(mask);
     const ImageF noisy = denoise::add_noise_in_mask(clean, mask, options.sigma / 255.0,
                                                     options.protocol_seed * 7919 + i);
     nlohmann::json entry{{"image", image.name},
@@ -151,7 +146,7 @@ void run_eval(const EvalOptions& options) {
     };
     record("noisy input", quality(clean, noisy, mask, clean_mask));
 
-    ImageF svd_guidance;
+    ImageF estimated_guidance;  // from --noise-method, for the guided methods
     for (const denoise::NoiseMethod method :
          {denoise::NoiseMethod::variance, denoise::NoiseMethod::svd}) {
       denoise::NoiseLevelParams params = guidance_params;
@@ -161,16 +156,16 @@ void run_eval(const EvalOptions& options) {
       const std::string name = method == denoise::NoiseMethod::svd ? "svd" : "var";
       record("noise map " + name,
              {{"auc", denoise::roc_auc(level, mask)},
-              {"auc_guidance", denoise::roc_auc(noisiness(guidance.map), mask)}});
+              {"auc_guidance", denoise::roc_auc(inverted(guidance.map), mask)}});
       save(options, image.name, "guidance-" + name, guidance.map);
-      if (method == guidance_params.method) svd_guidance = guidance.map;
+      if (method == guidance_params.method) estimated_guidance = guidance.map;
     }
     save(options, image.name, "clean", clean);
     save(options, image.name, "noisy", noisy);
     save(options, image.name, "mask", mask);
 
     for (const std::string& method : options.methods) {
-      const ImageF& guidance = options.oracle_guidance ? clean_mask : svd_guidance;
+      const ImageF& guidance = options.oracle_guidance ? clean_mask : estimated_guidance;
       const DenoiseRun run = run_denoiser(method, options.denoiser, noisy,
                                           method_is_guided(method) ? &guidance : nullptr);
       nlohmann::json values = quality(clean, run.result, mask, clean_mask);

@@ -20,7 +20,7 @@ struct RunOptions {
   std::string method = "guided-s2s";
   std::string guidance;
   std::string save_guidance;
-  std::string snapshot_dir;
+  std::string snapshot_dir = "snapshots";
   int snapshot_every = 0;
   int depth = 8;
   std::string report;
@@ -103,8 +103,7 @@ void register_denoise_run(CLI::App& denoise) {
                    "Write the current estimate every N iterations")
       ->check(CLI::NonNegativeNumber);
   command->add_option("--snapshot-dir", options->snapshot_dir, "Folder for the snapshots")
-      ->default_str("snapshots");
-  options->snapshot_dir = "snapshots";
+      ->capture_default_str();
   command->add_option("--depth", options->depth, "PNG output bit depth (8 or 16)")
       ->check(CLI::IsMember({8, 16}))
       ->capture_default_str();

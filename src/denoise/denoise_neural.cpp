@@ -36,8 +36,7 @@ ImageF denoise_neural(const ImageF& noisy, const ImageF* guidance, const NeuralP
   torch::set_num_threads(params.threads > 0 ? params.threads : static_cast<int>(cores));
   const torch::Device device = resolve_device(params.device);
   const torch::Tensor input = to_tensor(noisy, device);
-  const torch::Tensor guide =
-      is_guided(params.method) ? to_tensor(*guidance, device) : torch::Tensor();
+  const ImageF* guide = is_guided(params.method) ? guidance : nullptr;
 
   NeuralStats local;
   local.device = device.str();

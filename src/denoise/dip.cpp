@@ -6,8 +6,8 @@
 
 namespace glint::denoise {
 
-ImageF run_dip(const torch::Tensor& noisy, const torch::Tensor& guidance,
-               const NeuralParams& params, NeuralStats& stats) {
+ImageF run_dip(const torch::Tensor& noisy, const ImageF* guidance, const NeuralParams& params,
+               NeuralStats& stats) {
   const auto height = noisy.size(2), width = noisy.size(3);
   const int multiple = 1 << params.net.levels;
   UNet net(params.input_channels, static_cast<int>(noisy.size(1)), params.net);
@@ -21,7 +21,8 @@ ImageF run_dip(const torch::Tensor& noisy, const torch::Tensor& guidance,
                       multiple)
           .uniform_(0.0, params.input_scale);
   // Base of eq. (16)'s decay, per pixel: 0.9 + 0.1 m.
-  const torch::Tensor decay_base = guidance.defined() ? 0.9 + 0.1 * guidance : torch::Tensor();
+  const torch::Tensor decay_base =
+      guidance ? 0.9 + 0.1 * to_tensor(*guidance, noisy.device()) : torch::Tensor();
 
   torch::Tensor average;
   ProgressBar progress(method_name(params.method), static_cast<std::size_t>(params.iterations));

@@ -1,6 +1,6 @@
 #pragma once
-// The two optimisation loops behind denoise_neural() (neural.h). Tensors are (1, C, H, W) on
-// the chosen device; `guidance` is (1, 1, H, W) or undefined for the unguided methods.
+// The two optimisation loops behind denoise_neural() (neural.h). `noisy` is (1, C, H, W) on the
+// chosen device; `guidance` is the checked one-channel map, or null for the unguided methods.
 #include <torch/torch.h>
 
 #include <functional>
@@ -9,10 +9,10 @@
 
 namespace glint::denoise {
 
-ImageF run_dip(const torch::Tensor& noisy, const torch::Tensor& guidance,
-               const NeuralParams& params, NeuralStats& stats);
-ImageF run_self2self(const torch::Tensor& noisy, const torch::Tensor& guidance,
-                     const NeuralParams& params, NeuralStats& stats);
+ImageF run_dip(const torch::Tensor& noisy, const ImageF* guidance, const NeuralParams& params,
+               NeuralStats& stats);
+ImageF run_self2self(const torch::Tensor& noisy, const ImageF* guidance, const NeuralParams& params,
+                     NeuralStats& stats);
 
 // Input and target masks (1, 1, H, W) of one Self2Self sample: one uniform number per pixel
 // against the cumulative thresholds of eqs (20)-(23) (both < input-only < target-only).

@@ -1,7 +1,6 @@
 // Self2Self, plain and guided (the guided-denoising paper, §3.3): the U-Net learns to predict
 // pixels it did not see from those it saw, with decoder dropout; the result averages many
 // dropout samples.
-#include <cstring>
 #include <random>
 
 #include "core/progress.h"
@@ -12,44 +11,31 @@
 namespace glint::denoise {
 namespace {
 
-// Per-pixel maps computed once on the CPU from the importance p_imp (eq. (19)).
+// Per-pixel maps computed once from the importance p_imp (eq. (19)).
 struct MaskModel {
   torch::Tensor both_below, input_below, target_below;  // cumulative thresholds of eqs (20)-(22)
   std::vector<torch::Tensor> drop_rates;                // eq. (24) per decoder level
 };
 
-torch::Tensor map_tensor(const std::vector<float>& values, int64_t height, int64_t width,
-                         const torch::Device& device) {
-  auto t = torch::empty({1, 1, height, width}, torch::kFloat32);
-  std::memcpy(t.data_ptr<float>(), values.data(), values.size() * sizeof(float));
-  return t.to(device);
-}
-
-MaskModel make_mask_model(const torch::Tensor& guidance, int64_t height, int64_t width,
+MaskModel make_mask_model(const ImageF* guidance, int64_t height, int64_t width,
                           const NeuralParams& params, const torch::Device& device) {
-  const std::size_t n = static_cast<std::size_t>(height * width);
-  std::vector<float> importance(n, 0.f);
-  if (guidance.defined()) {
-    const torch::Tensor g = guidance.to(torch::kCPU).contiguous();
-    const float* m = g.data_ptr<float>();
-    for (std::size_t i = 0; i < n; ++i)
-      importance[i] = static_cast<float>(importance_probability(m[i], params.masks.exponent));
-  }
-  std::vector<float> both(n), input(n), target(n), rate(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const MaskProbabilities q = mask_probabilities(importance[i], params.masks);
-    both[i] = static_cast<float>(q.both);
-    input[i] = static_cast<float>(q.both + q.input_only);
-    target[i] = static_cast<float>(q.both + q.input_only + q.target_only);
-    rate[i] = static_cast<float>(modulated_dropout(importance[i], params.dropout));
+  const int w = static_cast<int>(width), h = static_cast<int>(height);
+  ImageF both(w, h, 1), input(w, h, 1), target(w, h, 1), rate(w, h, 1);
+  for (std::size_t i = 0; i < both.pixel_count(); ++i) {
+    const double importance =
+        guidance ? importance_probability(guidance->values()[i], params.masks.exponent) : 0.0;
+    const MaskProbabilities q = mask_probabilities(importance, params.masks);
+    both.values()[i] = static_cast<float>(q.both);
+    input.values()[i] = static_cast<float>(q.both + q.input_only);
+    target.values()[i] = static_cast<float>(q.both + q.input_only + q.target_only);
+    rate.values()[i] = static_cast<float>(modulated_dropout(importance, params.dropout));
   }
   MaskModel model;
-  model.both_below = map_tensor(both, height, width, device);
-  model.input_below = map_tensor(input, height, width, device);
-  model.target_below = map_tensor(target, height, width, device);
+  model.both_below = to_tensor(both, device);
+  model.input_below = to_tensor(input, device);
+  model.target_below = to_tensor(target, device);
   // Decoder level l runs at 1/2^l resolution: average the padded full-resolution rates.
-  const torch::Tensor full =
-      pad_to_multiple(map_tensor(rate, height, width, device), 1 << params.net.levels);
+  const torch::Tensor full = pad_to_multiple(to_tensor(rate, device), 1 << params.net.levels);
   for (int l = 0; l < params.net.levels; ++l)
     model.drop_rates.push_back(l == 0 ? full : torch::avg_pool2d(full, 1 << l));
   return model;
@@ -66,8 +52,8 @@ SampledMasks sample_masks(const torch::Tensor& both_below, const torch::Tensor& 
   return masks;
 }
 
-ImageF run_self2self(const torch::Tensor& noisy, const torch::Tensor& guidance,
-                     const NeuralParams& params, NeuralStats& stats) {
+ImageF run_self2self(const torch::Tensor& noisy, const ImageF* guidance, const NeuralParams& params,
+                     NeuralStats& stats) {
   const auto height = noisy.size(2), width = noisy.size(3), channels = noisy.size(1);
   const int multiple = 1 << params.net.levels;
   const MaskModel model = make_mask_model(guidance, height, width, params, noisy.device());
