@@ -1,0 +1,77 @@
+#include "io/trajectory.h"
+
+#include <cmath>
+#include <fmt/format.h>
+#include <sstream>
+
+#include "core/error.h"
+#include "io/atomic_file.h"
+#include "io/file_bytes.h"
+#include "io/json_report.h"
+
+namespace glint::io {
+
+std::vector<StampedPose> read_tum_trajectory(const std::string& path) {
+  std::istringstream text(read_file_bytes(path));
+  std::vector<StampedPose> poses;
+  std::string line;
+  for (int line_number = 1; std::getline(text, line); ++line_number) {
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    std::istringstream fields(line);
+    double v[8];
+    for (double& value : v) {
+      if (!(fields >> value) || !std::isfinite(value))
+        throw Error(path, "line " + std::to_string(line_number),
+                    "expected 8 finite numbers 'timestamp tx ty tz qx qy qz qw'");
+    }
+    Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+    const double norm = q.norm();
+    if (norm < 0.9 || norm > 1.1)
+      throw Error(path, "line " + std::to_string(line_number),
+                  fmt::format("quaternion has length {:.4g}, not 1", norm));
+    StampedPose stamped;
+    stamped.timestamp = v[0];
+    stamped.pose.linear() = q.normalized().toRotationMatrix();
+    stamped.pose.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+    poses.push_back(stamped);
+  }
+  return poses;
+}
+
+void write_tum_trajectory(const std::string& path, const std::vector<StampedPose>& poses) {
+  AtomicFile file(path, false);
+  file.stream() << "# timestamp tx ty tz qx qy qz qw (camera-to-world, metres)\n";
+  for (const StampedPose& p : poses) {
+    const Eigen::Quaterniond q(p.pose.rotation());
+    const Eigen::Vector3d t = p.pose.translation();
+    file.stream() << fmt::format("{:.6f} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g}\n",
+                                 p.timestamp, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+  }
+  file.commit();
+}
+
+Intrinsics read_intrinsics_json(const std::string& path) {
+  const nlohmann::json json = read_json(path);
+  Intrinsics k;
+  try {
+    k.width = json.at("width").get<int>();
+    k.height = json.at("height").get<int>();
+    k.fx = json.at("fx").get<double>();
+    k.fy = json.at("fy").get<double>();
+    k.cx = json.at("cx").get<double>();
+    k.cy = json.at("cy").get<double>();
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(path, "", std::string("intrinsics need width, height, fx, fy, cx, cy: ") + e.what());
+  }
+  if (!k.valid())
+    throw Error(path, "", "intrinsics need a positive width and height and non-zero fx, fy");
+  return k;
+}
+
+void write_intrinsics_json(const std::string& path, const Intrinsics& k) {
+  write_json(path, {{"width", k.width}, {"height", k.height}, {"fx", k.fx}, {"fy", k.fy},
+                    {"cx", k.cx}, {"cy", k.cy}});
+}
+
+}  // namespace glint::io
