@@ -32,8 +32,12 @@ struct Intrinsics {
 
   // The same camera at another resolution (pyramids, thumbnails): pixel centres stay aligned.
   Intrinsics scaled(double factor) const {
-    return {static_cast<int>(width * factor + 0.5), static_cast<int>(height * factor + 0.5),
-            fx * factor, fy * factor, (cx + 0.5) * factor - 0.5, (cy + 0.5) * factor - 0.5};
+    return {static_cast<int>(width * factor + 0.5),
+            static_cast<int>(height * factor + 0.5),
+            fx * factor,
+            fy * factor,
+            (cx + 0.5) * factor - 0.5,
+            (cy + 0.5) * factor - 0.5};
   }
 };
 

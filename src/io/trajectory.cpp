@@ -1,7 +1,8 @@
 #include "io/trajectory.h"
 
-#include <cmath>
 #include <fmt/format.h>
+
+#include <cmath>
 #include <sstream>
 
 #include "core/error.h"
@@ -62,7 +63,8 @@ Intrinsics read_intrinsics_json(const std::string& path) {
     k.cx = json.at("cx").get<double>();
     k.cy = json.at("cy").get<double>();
   } catch (const nlohmann::json::exception& e) {
-    throw Error(path, "", std::string("intrinsics need width, height, fx, fy, cx, cy: ") + e.what());
+    throw Error(path, "",
+                std::string("intrinsics need width, height, fx, fy, cx, cy: ") + e.what());
   }
   if (!k.valid())
     throw Error(path, "", "intrinsics need a positive width and height and non-zero fx, fy");
@@ -70,8 +72,12 @@ Intrinsics read_intrinsics_json(const std::string& path) {
 }
 
 void write_intrinsics_json(const std::string& path, const Intrinsics& k) {
-  write_json(path, {{"width", k.width}, {"height", k.height}, {"fx", k.fx}, {"fy", k.fy},
-                    {"cx", k.cx}, {"cy", k.cy}});
+  write_json(path, {{"width", k.width},
+                    {"height", k.height},
+                    {"fx", k.fx},
+                    {"fy", k.fy},
+                    {"cx", k.cx},
+                    {"cy", k.cy}});
 }
 
 }  // namespace glint::io

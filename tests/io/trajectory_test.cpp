@@ -34,7 +34,8 @@ TEST(Trajectory, TumQuaternionOrderIsXyzw) {
   const auto poses = read_tum_trajectory(path);
   ASSERT_EQ(poses.size(), 1u);
   // A quarter turn about z maps x to y.
-  EXPECT_TRUE((poses[0].pose.linear() * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitY()));
+  EXPECT_TRUE(
+      (poses[0].pose.linear() * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitY()));
   EXPECT_EQ(poses[0].pose.translation(), Eigen::Vector3d(1, 2, 3));
 }
 
@@ -76,8 +77,8 @@ TEST(Intrinsics, ProjectInvertsBackProject) {
   const Intrinsics half = k.scaled(0.5);
   EXPECT_EQ(half.width, 256);
   // The centre of the 2x2 block of pixels (0,0)-(1,1) is pixel (0,0) at half resolution.
-  EXPECT_TRUE(half.project(p * 1.0).isApprox((k.project(p) + Eigen::Vector2d(0.5, 0.5)) * 0.5 -
-                                                 Eigen::Vector2d(0.5, 0.5), 1e-12));
+  EXPECT_TRUE(half.project(p * 1.0).isApprox(
+      (k.project(p) + Eigen::Vector2d(0.5, 0.5)) * 0.5 - Eigen::Vector2d(0.5, 0.5), 1e-12));
 }
 
 }  // namespace

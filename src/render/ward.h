@@ -1,0 +1,47 @@
+#pragma once
+// Isotropic Ward BRDF (Ward 1992), as used by the reflectance pipeline (paper 1, eqs 2-4):
+//   f(wi, wo) = kd/pi + ks * exp(-tan^2(theta_h) / alpha^2) / (4 pi alpha^2 sqrt(cos_i cos_o))
+// kd and ks are linear RGB albedos (physically plausible when kd + ks <= 1 per channel), alpha
+// the roughness (Ward suits alpha up to ~0.3). Directions are unit vectors pointing away from
+// the surface; all maths is inline so a CUDA kernel can call it.
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+
+namespace glint::render {
+
+struct WardMaterial {
+  Eigen::Vector3f kd{0.5f, 0.5f, 0.5f};  // diffuse albedo, linear RGB
+  Eigen::Vector3f ks{0.0f, 0.0f, 0.0f};  // specular albedo, linear RGB
+  float alpha = 0.1f;                    // roughness, > 0
+};
+
+// Smallest roughness evaluated: below it the lobe is narrower than float precision resolves.
+inline constexpr float kMinWardAlpha = 1e-3f;
+// Cosines below this count as grazing: the specular term's 1/sqrt(cos_i cos_o) diverges there.
+inline constexpr float kGrazingCosine = 1e-4f;
+
+// The specular lobe's scalar factor exp(gamma) / N (eqs 3-4) for unit normal n and unit wi, wo
+// on the normal's side; 0 at grazing angles or when either direction is below the surface.
+inline float ward_specular_lobe(const Eigen::Vector3f& n, const Eigen::Vector3f& wi,
+                                const Eigen::Vector3f& wo, float alpha) {
+  const float cos_i = n.dot(wi), cos_o = n.dot(wo);
+  if (cos_i <= kGrazingCosine || cos_o <= kGrazingCosine) return 0.0f;
+  const float a = std::max(alpha, kMinWardAlpha);
+  const Eigen::Vector3f h = wi + wo;  // unnormalised half vector
+  const float cos_h2 = std::min(1.0f, n.dot(h) * n.dot(h) / h.squaredNorm());
+  if (cos_h2 <= 0.0f) return 0.0f;
+  const float tan_h2 = (1.0f - cos_h2) / cos_h2;                             // tan^2(theta_h)
+  const float gamma = -tan_h2 / (a * a);                                     // eq. (4)
+  const float norm = 4.0f * float(M_PI) * a * a * std::sqrt(cos_i * cos_o);  // eq. (3)
+  return std::exp(gamma) / norm;
+}
+
+// f(wi, wo) per RGB channel, eq. (2); 0 when either direction is below the surface.
+inline Eigen::Vector3f ward_brdf(const WardMaterial& m, const Eigen::Vector3f& n,
+                                 const Eigen::Vector3f& wi, const Eigen::Vector3f& wo) {
+  if (n.dot(wi) <= 0.0f || n.dot(wo) <= 0.0f) return Eigen::Vector3f::Zero();
+  return m.kd / float(M_PI) + m.ks * ward_specular_lobe(n, wi, wo, m.alpha);
+}
+
+}  // namespace glint::render
