@@ -1,0 +1,25 @@
+#pragma once
+// Albedo refinement (paper 1 §3.7): with the lights, the segment's specular parameters and the
+// voxel normal fixed, every observation B_k of a voxel gives one diffuse albedo by solving
+// eq. (6) for kd, eq. (7):
+//   kd = pi * (B_k - ks * sum_l exp(gamma_l) / N_l * L_l cos(theta_i,l)) / sum_l L_l cos(theta_i,l)
+// and the voxel's kd is the mean over its observations. L_l = intensity_l / r_l^2 (near-field
+// point lights); shadowing is ignored, as in the paper.
+#include <Eigen/Core>
+#include <optional>
+#include <vector>
+
+#include "reflectance/observation.h"
+#include "render/scene.h"
+
+namespace glint::reflectance {
+
+// Mean of eq. (7) over the voxel's observations (those seen from above the surface); nullopt
+// when there is none or no light reaches the surface point. No allocation.
+std::optional<Eigen::Vector3f> refine_albedo(const Observation* observations, int count,
+                                             const Eigen::Vector3f& position,
+                                             const Eigen::Vector3f& normal,
+                                             const std::vector<render::PointLight>& lights,
+                                             const Eigen::Vector3f& ks, float alpha);
+
+}  // namespace glint::reflectance
