@@ -1,0 +1,40 @@
+#pragma once
+// Per-frame geometric segmentation of a depth image after Tateno, Tombari and Navab (ICRA
+// 2016), as paper 1 §3.5 uses it: objects are assumed mostly convex, so segments are the
+// connected regions between concave boundaries and depth discontinuities.
+//   vertex map V and normals N (central differences, facing the camera)
+//   concavity  phi_c(u) = min_i [1 if (v_i - v).n <= eps else n.n_i]   edge if phi_c < tau_c
+//   distance   phi_d(u) = max_i |(v_i - v).n|                          edge if phi_d > k sigma(z)
+//   plus a depth-discontinuity test |z_i - z| / z > ratio
+// with sigma(z) = 0.0012 + 0.0019 (z - 0.4)^2 m, Kinect's axial noise (Nguyen et al. 2012).
+// Non-edge pixels form 4-connected components; small ones are dropped; edge pixels then take
+// the label of the nearest labelled pixel within a small window.
+#include <cstdint>
+
+#include "core/camera.h"
+#include "core/image.h"
+
+namespace glint::reflectance {
+
+struct DepthSegmentationParams {
+  int normal_step_px = 2;               // central-difference offset for normals
+  int neighbour_step_px = 2;            // the 8 neighbours v_i sit this many pixels away
+  float convexity_epsilon_m = 0.0005f;  // eps: neighbours this far in front still count convex
+  float min_convexity = 0.94f;          // tau_c
+  float distance_k = 6.0f;              // k in k sigma(z)
+  float discontinuity_ratio = 0.05f;    // |dz| / z
+  int min_segment_px = 300;             // smaller components become unlabelled (0)
+  int fill_radius_px = 4;               // edge pixels take a label from this window
+};
+
+struct DepthSegmentation {
+  Image<std::int32_t> labels;  // 0 = no segment (invalid depth, edge not filled, too small)
+  int segment_count = 0;       // labels are 1..segment_count
+  Image<std::uint8_t> edges;   // 1 where a concave boundary or discontinuity was detected
+};
+
+// depth: 1 channel, metres along the optical axis, 0 or non-finite = no measurement.
+DepthSegmentation segment_depth(const ImageF& depth, const Intrinsics& intrinsics,
+                                const DepthSegmentationParams& params = {});
+
+}  // namespace glint::reflectance
