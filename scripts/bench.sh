@@ -9,4 +9,5 @@ mkdir -p "$OUT"
 "$BUILD/bench/edges/edges_throughput" --points 1000000 --model models/bounded-3c.json \
   --data "$DATA/pointclouds/default-eval" --json "$OUT/edges_throughput.json"
 "$BUILD/bench/denoise/denoise_speed" --json "$OUT/denoise_speed.json"
+"$BUILD/bench/render/render_speed" --data "$DATA" --threads 2 --json "$OUT/render_speed.json"
 echo "bench: results in $OUT (the denoising protocol: scripts/eval-denoise.sh)"

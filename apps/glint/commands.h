@@ -28,4 +28,9 @@ void register_denoise_noise_map(CLI::App& denoise);
 void register_denoise_run(CLI::App& denoise);
 void register_denoise_eval(CLI::App& denoise);
 
+// `glint render SCENE.json -o DIR` (apps/glint/render_command.cpp).
+void register_render_command(CLI::App& app);
+// `glint synth cubes|bunnies|office|lights|training -o DIR` (apps/glint/synth_command.cpp).
+void register_synth_command(CLI::App& app);
+
 }  // namespace glint::app

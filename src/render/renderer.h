@@ -1,0 +1,52 @@
+#pragma once
+// Direct-lighting ray caster for render::Scene on Embree 3: one camera ray through each pixel
+// centre, shaded with the Ward BRDF (paper 1 eqs 2-4) under the scene's near-field point lights
+//   L_o = sum_lights  I / r^2 * f(wi, wo) * cos(theta_i)     (times visibility with shadows)
+// plus, optionally, the environment map (importance-sampled, scene.environment->samples rays
+// per pixel, seeded by scene.seed and the frame index). No interreflections, no ambient term:
+// a surface no light sees is exactly black, as the reflectance pipeline assumes.
+// Surfaces are two-sided (normals face the camera). Light proxies are emissive spheres of
+// radiance I / (pi r^2), seen by camera rays but transparent to shadow rays; their pixels get
+// depth and normal but segment 0 and zero material maps. Background: the environment's
+// radiance, or 0. Thread safety: render() is const and may run concurrently.
+#include <cstdint>
+#include <memory>
+
+#include "core/camera.h"
+#include "core/image.h"
+#include "render/scene.h"
+
+namespace glint::render {
+
+// One frame's noise-free buffers at the scene's intrinsics resolution, row-major planes.
+struct FrameBuffers {
+  ImageF radiance;               // 3 ch, linear RGB scene radiance (before exposure)
+  ImageF depth;                  // 1 ch, z-depth along the optical axis in metres, 0 = none
+  ImageF normal;                 // 3 ch, unit world-space shading normal, 0 = none
+  Image<std::uint16_t> segment;  // 1 ch, Object::id, 0 = background or light proxy
+  ImageF kd, ks;                 // 3 ch, linear Ward albedos (kd from the texture if any)
+  ImageF alpha;                  // 1 ch, Ward roughness, 0 = none
+};
+
+class Renderer {
+ public:
+  // Loads meshes, textures and the environment map and builds the Embree scene once. Throws
+  // glint::Error naming the file for unreadable inputs, or the object for invalid shapes.
+  explicit Renderer(const Scene& scene);
+  ~Renderer();
+  Renderer(Renderer&&) noexcept;
+  Renderer& operator=(Renderer&&) noexcept;
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Renders the view from camera_to_world; frame_index seeds the environment sampling.
+  FrameBuffers render(const Pose& camera_to_world, int frame_index) const;
+
+  const Scene& scene() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace glint::render
