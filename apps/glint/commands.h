@@ -32,5 +32,7 @@ void register_denoise_eval(CLI::App& denoise);
 void register_render_command(CLI::App& app);
 // `glint synth cubes|bunnies|office|lights|training -o DIR` (apps/glint/synth_command.cpp).
 void register_synth_command(CLI::App& app);
+// `glint fuse DATASET -o MESH.ply` (apps/glint/fuse_command.cpp).
+void register_fuse_command(CLI::App& app);
 
 }  // namespace glint::app

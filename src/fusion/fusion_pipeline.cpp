@@ -1,0 +1,56 @@
+#include "fusion/fusion_pipeline.h"
+
+#include "core/error.h"
+#include "core/timer.h"
+
+namespace glint::fusion {
+
+FusionPipeline::FusionPipeline(const Intrinsics& intrinsics, const FusionParams& params)
+    : intrinsics_(intrinsics), params_(params), volume_(params.volume) {}
+
+Pose FusionPipeline::predict_pose() const {
+  if (poses_.size() < 2) return poses_.back();
+  const Pose& last = poses_.back();
+  return last * (poses_[poses_.size() - 2].inverse() * last);
+}
+
+FrameResult FusionPipeline::process(const io::RgbdFrame& frame) {
+  FrameResult result;
+  if (params_.use_ground_truth_poses) {
+    if (!frame.ground_truth)
+      throw Error("frame " + std::to_string(frame.index), "",
+                  "has no ground-truth pose (drop --gt-poses to track instead)");
+    result.camera_to_world = *frame.ground_truth;
+  } else if (poses_.empty()) {
+    result.camera_to_world = frame.ground_truth.value_or(Pose::Identity());
+  } else {
+    Stopwatch watch;
+    result.tracking = track_frame(frame.depth_m, intrinsics_, model_, intrinsics_, poses_.back(),
+                                  predict_pose(), params_.tracking);
+    timings_.add("track", watch.elapsed_ms());
+    result.camera_to_world = result.tracking->status == TrackingStatus::tracked
+                                 ? result.tracking->camera_to_world
+                                 : poses_.back();
+  }
+  poses_.push_back(result.camera_to_world);
+
+  if (!result.tracking || result.tracking->status == TrackingStatus::tracked) {
+    Stopwatch watch;
+    allocate_blocks(volume_, frame.depth_m, intrinsics_, result.camera_to_world, visible_);
+    const double allocate_ms = watch.elapsed_ms();
+    integrate_blocks(volume_, visible_, frame.depth_m, frame.colour, intrinsics_,
+                     result.camera_to_world);
+    timings_.add("integrate", watch.elapsed_ms());
+    timings_.add("allocate_blocks", allocate_ms);
+    result.integrated = true;
+    result.visible_blocks = visible_.indices.size();
+  }
+  if (!params_.use_ground_truth_poses) {
+    Stopwatch watch;
+    model_ = raycast(volume_, intrinsics_, result.camera_to_world);
+    timings_.add("raycast", watch.elapsed_ms());
+  }
+  return result;
+}
+
+}  // namespace glint::fusion

@@ -1,0 +1,169 @@
+#include "fusion/integrate.h"
+
+#include <fmt/format.h>
+#include <tbb/enumerable_thread_specific.h>
+
+#include <array>
+#include <atomic>
+
+#include "core/error.h"
+#include "core/parallel.h"
+#include "fusion/tsdf_kernels.h"
+
+namespace glint::fusion {
+namespace {
+
+// Neighbouring pixels mostly hit the same blocks: a small direct-mapped cache of the blocks a
+// chunk of rows already handled skips most repeated hash insertions.
+class RecentBlocks {
+ public:
+  RecentBlocks() { keys_.fill(~std::uint64_t{0}); }
+  // True when the block was seen recently; remembers it otherwise.
+  bool seen(int x, int y, int z) {
+    const std::uint64_t key = pack_block_key(x, y, z);
+    std::uint64_t& slot = keys_[teschner_hash(x, y, z) & (keys_.size() - 1)];
+    if (slot == key) return true;
+    slot = key;
+    return false;
+  }
+
+ private:
+  std::array<std::uint64_t, 256> keys_;
+};
+
+void require_same_size(const ImageF& depth_m, const ImageF& colour, const Intrinsics& k) {
+  if (depth_m.channels() != 1 || depth_m.width() != k.width || depth_m.height() != k.height)
+    throw Error("depth image", "",
+                fmt::format("expected {}x{} with 1 channel, got {}x{}x{}", k.width, k.height,
+                            depth_m.width(), depth_m.height(), depth_m.channels()));
+  if (!colour.empty() && (colour.channels() != 3 || !colour.same_size(depth_m)))
+    throw Error("colour image", "",
+                fmt::format("expected {}x{} with 3 channels, got {}x{}x{}", k.width, k.height,
+                            colour.width(), colour.height(), colour.channels()));
+}
+
+}  // namespace
+
+void allocate_blocks(TsdfVolume& volume, const ImageF& depth_m, const Intrinsics& intrinsics,
+                     const Pose& camera_to_world, VisibleBlocks& visible) {
+  require_same_size(depth_m, ImageF(), intrinsics);
+  const VolumeParams& params = volume.params();
+  const Eigen::Matrix3f rotation = camera_to_world.linear().cast<float>();
+  const Eigen::Vector3f origin = camera_to_world.translation().cast<float>();
+  const float block_size = static_cast<float>(params.block_size_m());
+  const int width = depth_m.width();
+  const std::size_t height = depth_m.height();
+  const int stride = params.allocation_stride_px;
+  const float* depth = depth_m.plane(0);
+  const int frame = ++visible.frame;
+  std::atomic<bool> pool_full{false};
+  tbb::enumerable_thread_specific<std::vector<int>> found;
+
+  const std::size_t rows = (depth_m.height() + stride - 1) / stride;
+  parallel_for_chunks(rows, 4, [&](std::size_t row_begin, std::size_t row_end) {
+    RecentBlocks recent;
+    std::vector<int>& local = found.local();
+    for (std::size_t y = row_begin * stride; y < row_end * stride && y < height; y += stride) {
+      for (int x = 0; x < width; x += stride) {
+        const float d = depth[y * width + x];
+        if (!(d >= params.depth_min_m && d <= params.depth_max_m)) continue;
+        const float truncation = static_cast<float>(params.truncation_at(d));
+        const Eigen::Vector3f ray =
+            rotation * intrinsics.ray(x, static_cast<double>(y)).cast<float>();
+        const Eigen::Vector3f near = origin + ray * (d - truncation);
+        const Eigen::Vector3f far = origin + ray * (d + truncation);
+        for_each_cell_on_segment(near.data(), far.data(), block_size, [&](int bx, int by, int bz) {
+          if (recent.seen(bx, by, bz)) return;
+          const int index = volume.allocate({bx, by, bz});
+          if (index < 0) {
+            pool_full.store(true, std::memory_order_relaxed);
+            return;
+          }
+          if (volume.mark_visible(index, frame)) local.push_back(index);
+        });
+      }
+    }
+  });
+
+  visible.indices.clear();
+  for (const std::vector<int>& local : found)
+    visible.indices.insert(visible.indices.end(), local.begin(), local.end());
+  if (pool_full)
+    throw Error("TSDF volume", "block pool",
+                fmt::format("all {} blocks are in use; raise the block capacity (--blocks) or the "
+                            "voxel size",
+                            params.block_capacity));
+}
+
+void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const ImageF& depth_m,
+                      const ImageF& colour, const Intrinsics& intrinsics,
+                      const Pose& camera_to_world) {
+  require_same_size(depth_m, colour, intrinsics);
+  const VolumeParams& params = volume.params();
+  const Pose world_to_camera = camera_to_world.inverse();
+  const Eigen::Matrix3f rotation = world_to_camera.linear().cast<float>();
+  const Eigen::Vector3f translation = world_to_camera.translation().cast<float>();
+  const float voxel = static_cast<float>(params.voxel_size_m);
+  const Eigen::Vector3f step_x = rotation.col(0) * voxel;
+  const Eigen::Vector3f step_y = rotation.col(1) * voxel;
+  const Eigen::Vector3f step_z = rotation.col(2) * voxel;
+  const float fx = static_cast<float>(intrinsics.fx), fy = static_cast<float>(intrinsics.fy);
+  const float cx = static_cast<float>(intrinsics.cx), cy = static_cast<float>(intrinsics.cy);
+  const float truncation_m = static_cast<float>(params.truncation_m);
+  const float truncation_per_depth = static_cast<float>(params.truncation_per_depth);
+  const float max_weight = params.max_weight;
+  const float depth_min = static_cast<float>(params.depth_min_m);
+  const float depth_max = static_cast<float>(params.depth_max_m);
+  const int width = depth_m.width(), height = depth_m.height();
+  const float* depth = depth_m.plane(0);
+  const bool with_colour = !colour.empty();
+  const float* red_in = with_colour ? colour.plane(0) : nullptr;
+  const float* green_in = with_colour ? colour.plane(1) : nullptr;
+  const float* blue_in = with_colour ? colour.plane(2) : nullptr;
+
+  parallel_for(visible.indices.size(), [&](std::size_t i) {
+    const int block = visible.indices[i];
+    const Eigen::Vector3f origin =
+        rotation * volume.block_origin_m(volume.hash().block(block)).cast<float>() + translation;
+    float* sdf = volume.sdf_m(block);
+    float* weight = volume.weight(block);
+    float* red = volume.red(block);
+    float* green = volume.green(block);
+    float* blue = volume.blue(block);
+    int voxel_index = 0;
+    for (int z = 0; z < kBlockSide; ++z) {
+      for (int y = 0; y < kBlockSide; ++y) {
+        Eigen::Vector3f p =
+            origin + step_z * static_cast<float>(z) + step_y * static_cast<float>(y);
+        for (int x = 0; x < kBlockSide; ++x, ++voxel_index, p += step_x) {
+          if (p.z() <= 0) continue;
+          const float inverse_z = 1.0f / p.z();
+          int px, py;
+          if (!nearest_pixel(fx * p.x() * inverse_z + cx, fy * p.y() * inverse_z + cy, width,
+                             height, px, py))
+            continue;
+          const int pixel = py * width + px;
+          const float d = depth[pixel];
+          if (!(d >= depth_min && d <= depth_max)) continue;
+          const float weight_before = weight[voxel_index];
+          if (!fuse_voxel(d - p.z(), truncation_m + truncation_per_depth * d, max_weight,
+                          sdf[voxel_index], weight[voxel_index]))
+            continue;
+          if (with_colour) {
+            red[voxel_index] = fuse_colour(red[voxel_index], weight_before, red_in[pixel]);
+            green[voxel_index] = fuse_colour(green[voxel_index], weight_before, green_in[pixel]);
+            blue[voxel_index] = fuse_colour(blue[voxel_index], weight_before, blue_in[pixel]);
+          }
+        }
+      }
+    }
+  });
+}
+
+void integrate(TsdfVolume& volume, const ImageF& depth_m, const ImageF& colour,
+               const Intrinsics& intrinsics, const Pose& camera_to_world, VisibleBlocks& visible) {
+  allocate_blocks(volume, depth_m, intrinsics, camera_to_world, visible);
+  integrate_blocks(volume, visible, depth_m, colour, intrinsics, camera_to_world);
+}
+
+}  // namespace glint::fusion

@@ -1,0 +1,154 @@
+#include "fusion/raycast.h"
+
+#include <atomic>
+#include <bit>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "core/parallel.h"
+#include "fusion/depth_maps.h"
+#include "fusion/tsdf_sampler.h"
+
+namespace glint::fusion {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr int kTilePx = 8;
+
+// Per 8x8-pixel tile, the camera-depth interval that allocated blocks cover (the union of their
+// projected bounding boxes), so rays skip the empty space in front of and behind the model.
+// Depths are positive floats kept as their bit patterns, which order like the values.
+class TileDepthRanges {
+ public:
+  TileDepthRanges(const TsdfVolume& volume, const Intrinsics& k, const Pose& camera_to_world)
+      : tiles_x_((k.width + kTilePx - 1) / kTilePx),
+        near_(std::size_t(tiles_x_) * ((k.height + kTilePx - 1) / kTilePx)),
+        far_(near_.size()) {
+    for (std::size_t i = 0; i < near_.size(); ++i) {
+      near_[i].store(std::bit_cast<std::uint32_t>(std::numeric_limits<float>::max()));
+      far_[i].store(0);
+    }
+    const VolumeParams& params = volume.params();
+    const Pose world_to_camera = camera_to_world.inverse();
+    const double block = params.block_size_m();
+    const int tiles_y = int(near_.size()) / tiles_x_;
+    parallel_for(volume.block_count(), [&](std::size_t b) {
+      const Eigen::Vector3d origin = volume.block_origin_m(volume.hash().block(int(b)));
+      Eigen::Vector2d low(1e30, 1e30), high(-1e30, -1e30);
+      double z_min = 1e30, z_max = -1e30;
+      Eigen::Vector3d corners[8];
+      for (int c = 0; c < 8; ++c) {
+        corners[c] =
+            world_to_camera * (origin + block * Eigen::Vector3d(c & 1, (c >> 1) & 1, (c >> 2) & 1));
+        z_min = std::min(z_min, corners[c].z());
+        z_max = std::max(z_max, corners[c].z());
+      }
+      if (z_max < params.depth_min_m || z_min > params.depth_max_m) return;
+      int x0 = 0, y0 = 0, x1 = tiles_x_ - 1, y1 = tiles_y - 1;
+      if (z_min > params.depth_min_m) {  // wholly in front of the camera: its projected box
+        for (const Eigen::Vector3d& corner : corners) {
+          const Eigen::Vector2d uv = k.project(corner);
+          low = low.cwiseMin(uv);
+          high = high.cwiseMax(uv);
+        }
+        x0 = std::max(0, int(std::floor((low.x() + 0.5) / kTilePx)));
+        y0 = std::max(0, int(std::floor((low.y() + 0.5) / kTilePx)));
+        x1 = std::min(tiles_x_ - 1, int(std::floor((high.x() + 0.5) / kTilePx)));
+        y1 = std::min(tiles_y - 1, int(std::floor((high.y() + 0.5) / kTilePx)));
+      }
+      const auto near = std::bit_cast<std::uint32_t>(float(std::max(z_min, params.depth_min_m)));
+      const auto far = std::bit_cast<std::uint32_t>(float(z_max));
+      for (int ty = y0; ty <= y1; ++ty)
+        for (int tx = x0; tx <= x1; ++tx) {
+          const std::size_t tile = std::size_t(ty) * tiles_x_ + tx;
+          for (auto value = near_[tile].load();
+               near < value && !near_[tile].compare_exchange_weak(value, near);) {
+          }
+          for (auto value = far_[tile].load();
+               far > value && !far_[tile].compare_exchange_weak(value, far);) {
+          }
+        }
+    });
+  }
+
+  // The interval of pixel (x, y); empty (near > far) when no block projects there.
+  void interval(int x, int y, float& near, float& far) const {
+    const std::size_t tile = std::size_t(y / kTilePx) * tiles_x_ + x / kTilePx;
+    near = std::bit_cast<float>(near_[tile].load(std::memory_order_relaxed));
+    far = std::bit_cast<float>(far_[tile].load(std::memory_order_relaxed));
+  }
+
+ private:
+  int tiles_x_;
+  std::vector<std::atomic<std::uint32_t>> near_, far_;
+};
+
+// Depth t (metres along the optical axis) of the first + to - crossing along origin + t * ray,
+// or 0 when there is none in [t_min, t_max]. ray has z = 1 in camera space.
+float march(TsdfSampler& sampler, const Eigen::Vector3f& origin, const Eigen::Vector3f& ray,
+            float t_min, float t_max, float voxel, float block) {
+  const float inverse_length = 1.0f / ray.norm();
+  float previous_t = 0, previous_sdf = 0;
+  bool previous_observed = false;
+  for (float t = t_min; t <= t_max;) {
+    const Eigen::Vector3f p = origin + ray * t;
+    float sdf;
+    TsdfSampler::Sample sample = sampler.nearest(p, sdf);
+    // Near the surface, the trilinear value (a voxel without all 8 neighbours observed counts
+    // as unobserved).
+    if (sample == TsdfSampler::Sample::observed && sdf < 2 * voxel && !sampler.trilinear(p, sdf))
+      sample = TsdfSampler::Sample::unobserved;
+    if (sample != TsdfSampler::Sample::observed) {
+      previous_observed = false;
+      t += (sample == TsdfSampler::Sample::unallocated ? 0.5f * block : voxel) * inverse_length;
+      continue;
+    }
+    if (sdf < 0) {
+      if (!previous_observed) return 0;  // entered behind a surface: a back face
+      return previous_t + (t - previous_t) * previous_sdf / (previous_sdf - sdf);
+    }
+    previous_t = t;
+    previous_sdf = sdf;
+    previous_observed = true;
+    t += std::max(voxel, 0.8f * sdf) * inverse_length;
+  }
+  return 0;
+}
+
+}  // namespace
+
+SurfaceView raycast(const TsdfVolume& volume, const Intrinsics& intrinsics,
+                    const Pose& camera_to_world) {
+  const int width = intrinsics.width, height = intrinsics.height;
+  SurfaceView view{ImageF(width, height, 1), ImageF(width, height, 3, kNaN), ImageF(),
+                   ImageF(width, height, 3)};
+  const Eigen::Matrix3f rotation = camera_to_world.linear().cast<float>();
+  const Eigen::Vector3f origin = camera_to_world.translation().cast<float>();
+  const VolumeParams& params = volume.params();
+  const float voxel = float(params.voxel_size_m), block = float(params.block_size_m());
+  const TileDepthRanges ranges(volume, intrinsics, camera_to_world);
+  parallel_for(static_cast<std::size_t>(height), [&](std::size_t row) {
+    TsdfSampler sampler(volume);
+    const int y = static_cast<int>(row);
+    for (int x = 0; x < width; ++x) {
+      float near, far;
+      ranges.interval(x, y, near, far);
+      if (near > far) continue;
+      const Eigen::Vector3f ray = rotation * intrinsics.ray(x, y).cast<float>();
+      const float t = march(sampler, origin, ray, near, far, voxel, block);
+      if (t <= 0) continue;
+      const Eigen::Vector3f p = origin + ray * t;
+      view.depth_m.at(x, y, 0) = t;
+      const Eigen::Vector3f colour = sampler.nearest_colour(p);
+      for (int c = 0; c < 3; ++c) {
+        view.points_m.at(x, y, c) = p[c];
+        view.colour.at(x, y, c) = colour[c];
+      }
+    }
+  });
+  view.normals = normals_from_points(view.points_m, camera_to_world.translation());
+  return view;
+}
+
+}  // namespace glint::fusion

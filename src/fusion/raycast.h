@@ -1,0 +1,26 @@
+#pragma once
+// Ray casting of the TSDF's zero crossing for one camera view (VoxelHashing §5; KinectFusion
+// §3.4): the model view that tracking aligns the next frame to, and a rendering of the model.
+// Rays march through the depth interval that allocated blocks cover in their 8x8-pixel tile
+// (within depth_min_m..depth_max_m of the volume parameters): half a block at a time
+// through unallocated space, one voxel through unobserved voxels, 0.8 * |sdf| (at least one
+// voxel) through observed ones, reading trilinear values within 2 voxels of the surface; the
+// first + to - crossing is located by linear interpolation between the two samples around it.
+// Back faces (- first) end the ray without a hit.
+#include "core/camera.h"
+#include "core/image.h"
+#include "fusion/tsdf_volume.h"
+
+namespace glint::fusion {
+
+struct SurfaceView {
+  ImageF depth_m;   // 1 channel, z along the optical axis, 0 = no hit
+  ImageF points_m;  // 3 channels, world coordinates, NaN = no hit
+  ImageF normals;   // 3 channels, world, unit, towards the camera; NaN = none
+  ImageF colour;    // 3 channels, linear RGB of the nearest voxel, 0 = no hit
+};
+
+SurfaceView raycast(const TsdfVolume& volume, const Intrinsics& intrinsics,
+                    const Pose& camera_to_world);
+
+}  // namespace glint::fusion

@@ -1,0 +1,72 @@
+#include "fusion/triangle_mesh.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+
+#include "io/atomic_file.h"
+
+namespace glint::fusion {
+
+double surface_area(const TriangleMesh& mesh) {
+  double area = 0;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    const Eigen::Vector3d a = mesh.vertices[t[0]].cast<double>();
+    area += 0.5 * (mesh.vertices[t[1]].cast<double>() - a)
+                      .cross(mesh.vertices[t[2]].cast<double>() - a)
+                      .norm();
+  }
+  return area;
+}
+
+double enclosed_volume(const TriangleMesh& mesh) {
+  double volume = 0;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    volume += mesh.vertices[t[0]].cast<double>().dot(
+                  mesh.vertices[t[1]].cast<double>().cross(mesh.vertices[t[2]].cast<double>())) /
+              6.0;
+  }
+  return volume;
+}
+
+unsigned char linear_to_srgb8(float linear) {
+  const float c = std::clamp(linear, 0.0f, 1.0f);
+  const float encoded = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+  return static_cast<unsigned char>(std::lround(encoded * 255.0f));
+}
+
+void write_mesh_ply(const std::string& path, const TriangleMesh& mesh) {
+  io::AtomicFile file(path);
+  std::ostream& out = file.stream();
+  const bool with_colour = mesh.colours.size() == mesh.vertices.size();
+  out << "ply\nformat binary_little_endian 1.0\ncomment glint fuse (voxel-hashed TSDF)\n"
+      << "element vertex " << mesh.vertices.size() << "\n"
+      << "property float x\nproperty float y\nproperty float z\n";
+  if (with_colour) out << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  out << "element face " << mesh.triangles.size() << "\n"
+      << "property list uchar int vertex_indices\nend_header\n";
+  std::vector<char> buffer;
+  const std::size_t vertex_bytes = 12 + (with_colour ? 3 : 0);
+  buffer.resize(mesh.vertices.size() * vertex_bytes);
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    char* record = buffer.data() + i * vertex_bytes;
+    std::memcpy(record, mesh.vertices[i].data(), 12);
+    if (with_colour) {
+      for (int c = 0; c < 3; ++c)
+        record[12 + c] = static_cast<char>(linear_to_srgb8(mesh.colours[i][c]));
+    }
+  }
+  out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+  buffer.resize(mesh.triangles.size() * 13);
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    char* record = buffer.data() + i * 13;
+    record[0] = 3;
+    std::memcpy(record + 1, mesh.triangles[i].data(), 12);
+  }
+  out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+  file.commit();
+}
+
+}  // namespace glint::fusion

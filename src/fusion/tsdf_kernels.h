@@ -1,0 +1,69 @@
+#pragma once
+// Per-voxel and per-ray maths of TSDF fusion, as small inline functions that the TBB loops call
+// and a CUDA kernel could call too (no allocation, no exceptions).
+#include <cmath>
+
+#include "fusion/host_device.h"
+
+namespace glint::fusion {
+
+// Weighted running average of one voxel with one projective observation (Curless & Levoy 1996;
+// VoxelHashing §4.2): measured_sdf_m = depth - z along the optical axis. Observations more than
+// `truncation_m` behind the surface are ignored (returns false); in front they are clamped.
+GLINT_HOST_DEVICE inline bool fuse_voxel(float measured_sdf_m, float truncation_m, float max_weight,
+                                         float& sdf_m, float& weight) {
+  if (measured_sdf_m < -truncation_m) return false;
+  const float observation = measured_sdf_m < truncation_m ? measured_sdf_m : truncation_m;
+  const float total = weight + 1.0f;
+  sdf_m = (sdf_m * weight + observation) / total;
+  weight = total < max_weight ? total : max_weight;
+  return true;
+}
+
+// The same running average for a colour channel; `weight_before` is the voxel's weight before
+// fuse_voxel() updated it.
+GLINT_HOST_DEVICE inline float fuse_colour(float mean, float weight_before, float observation) {
+  return (mean * weight_before + observation) / (weight_before + 1.0f);
+}
+
+// Nearest pixel of a projected point, or false when it falls outside a width x height image.
+GLINT_HOST_DEVICE inline bool nearest_pixel(float u, float v, int width, int height, int& x,
+                                            int& y) {
+  if (!(u >= -0.5f && v >= -0.5f && u < width - 0.5f && v < height - 0.5f)) return false;
+  x = static_cast<int>(u + 0.5f);
+  y = static_cast<int>(v + 0.5f);
+  return true;
+}
+
+// Calls visit(bx, by, bz) for every cell of a grid of side `cell` that the segment a -> b
+// crosses, in order (Amanatides & Woo 1987). Coordinates in metres.
+template <class Visit>
+GLINT_HOST_DEVICE inline void for_each_cell_on_segment(const float a[3], const float b[3],
+                                                       float cell, Visit&& visit) {
+  int index[3], step[3], end[3];
+  float t_max[3], t_delta[3];
+  for (int i = 0; i < 3; ++i) {
+    index[i] = static_cast<int>(std::floor(a[i] / cell));
+    end[i] = static_cast<int>(std::floor(b[i] / cell));
+    const float direction = b[i] - a[i];
+    step[i] = direction > 0 ? 1 : (direction < 0 ? -1 : 0);
+    if (step[i] == 0) {
+      t_max[i] = t_delta[i] = INFINITY;
+      continue;
+    }
+    const float boundary = (index[i] + (step[i] > 0 ? 1 : 0)) * cell;
+    t_max[i] = (boundary - a[i]) / direction;
+    t_delta[i] = cell / std::fabs(direction);
+  }
+  const int cells =
+      std::abs(end[0] - index[0]) + std::abs(end[1] - index[1]) + std::abs(end[2] - index[2]);
+  for (int n = 0; n <= cells; ++n) {
+    visit(index[0], index[1], index[2]);
+    const int axis =
+        t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
+    index[axis] += step[axis];
+    t_max[axis] += t_delta[axis];
+  }
+}
+
+}  // namespace glint::fusion

@@ -1,0 +1,33 @@
+#include "fusion/tsdf_volume.h"
+
+#include <algorithm>
+
+namespace glint::fusion {
+
+TsdfVolume::TsdfVolume(const VolumeParams& params)
+    : params_((validate(params), params)),
+      hash_(params.block_capacity),
+      // new T[] without () leaves the pools uninitialised: pages are committed on first use.
+      sdf_m_(new float[params.block_capacity * kVoxelsPerBlock]),
+      weight_(new float[params.block_capacity * kVoxelsPerBlock]),
+      red_(new float[params.block_capacity * kVoxelsPerBlock]),
+      green_(new float[params.block_capacity * kVoxelsPerBlock]),
+      blue_(new float[params.block_capacity * kVoxelsPerBlock]),
+      last_visible_(new std::atomic<int>[params.block_capacity]) {
+  for (std::size_t b = 0; b < params.block_capacity; ++b) last_visible_[b].store(-1);
+}
+
+int TsdfVolume::allocate(const Eigen::Vector3i& block) {
+  const VoxelBlockHash::Insertion insertion = hash_.insert(block);
+  if (insertion.inserted) {
+    const int b = insertion.index;
+    std::fill_n(sdf_m(b), kVoxelsPerBlock, 0.0f);
+    std::fill_n(weight(b), kVoxelsPerBlock, 0.0f);
+    std::fill_n(red(b), kVoxelsPerBlock, 0.0f);
+    std::fill_n(green(b), kVoxelsPerBlock, 0.0f);
+    std::fill_n(blue(b), kVoxelsPerBlock, 0.0f);
+  }
+  return insertion.index;
+}
+
+}  // namespace glint::fusion

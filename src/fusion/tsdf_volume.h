@@ -1,0 +1,66 @@
+#pragma once
+// TsdfVolume: the voxel-hashed truncated signed distance field with colour. Voxel data are flat
+// structure-of-arrays pools indexed by block * kVoxelsPerBlock + voxel, voxel = (z*8 + y)*8 + x;
+// the pools are allocated once (capacity from VolumeParams) and their pages are committed only
+// as blocks are used. A voxel with weight 0 has never been observed.
+//
+// Voxel values: sdf_m, signed distance along the viewing ray in metres (positive in front of the
+// surface), clamped to the truncation band; weight, number of fused observations (saturating);
+// red, green, blue, weighted mean linear colour.
+#include <Eigen/Core>
+#include <atomic>
+#include <memory>
+#include <vector>
+
+#include "fusion/volume_params.h"
+#include "fusion/voxel_block_hash.h"
+
+namespace glint::fusion {
+
+class TsdfVolume {
+ public:
+  explicit TsdfVolume(const VolumeParams& params = {});
+
+  const VolumeParams& params() const { return params_; }
+  VoxelBlockHash& hash() { return hash_; }
+  const VoxelBlockHash& hash() const { return hash_; }
+  std::size_t block_count() const { return hash_.size(); }
+
+  // World position of a block's first voxel (its minimum corner voxel), metres.
+  Eigen::Vector3d block_origin_m(const Eigen::Vector3i& block) const {
+    return block.cast<double>() * params_.block_size_m();
+  }
+
+  // Inserts the block (zeroed) if absent; thread-safe against concurrent calls. Returns its
+  // pool index or VoxelBlockHash::kPoolFull.
+  int allocate(const Eigen::Vector3i& block);
+
+  float* sdf_m(int block) { return sdf_m_.get() + voxel_offset(block); }
+  float* weight(int block) { return weight_.get() + voxel_offset(block); }
+  float* red(int block) { return red_.get() + voxel_offset(block); }
+  float* green(int block) { return green_.get() + voxel_offset(block); }
+  float* blue(int block) { return blue_.get() + voxel_offset(block); }
+  const float* sdf_m(int block) const { return sdf_m_.get() + voxel_offset(block); }
+  const float* weight(int block) const { return weight_.get() + voxel_offset(block); }
+  const float* red(int block) const { return red_.get() + voxel_offset(block); }
+  const float* green(int block) const { return green_.get() + voxel_offset(block); }
+  const float* blue(int block) const { return blue_.get() + voxel_offset(block); }
+
+  // Marks a block seen in frame `frame`; true for the first caller per frame (thread-safe), so
+  // the caller appends it to the frame's visible list exactly once.
+  bool mark_visible(int block, int frame) {
+    return last_visible_[block].exchange(frame, std::memory_order_relaxed) != frame;
+  }
+
+ private:
+  static std::size_t voxel_offset(int block) {
+    return static_cast<std::size_t>(block) * kVoxelsPerBlock;
+  }
+
+  VolumeParams params_;
+  VoxelBlockHash hash_;
+  std::unique_ptr<float[]> sdf_m_, weight_, red_, green_, blue_;
+  std::unique_ptr<std::atomic<int>[]> last_visible_;
+};
+
+}  // namespace glint::fusion

@@ -1,0 +1,22 @@
+#include "fusion/volume_params.h"
+
+#include "core/error.h"
+
+namespace glint::fusion {
+
+void validate(const VolumeParams& params) {
+  const auto fail = [](const char* name, const char* reason) {
+    throw Error("volume parameters", name, reason);
+  };
+  if (!(params.voxel_size_m > 0)) fail("voxel_size_m", "must be positive");
+  if (!(params.truncation_m > 0) || params.truncation_per_depth < 0)
+    fail("truncation_m", "must be positive (and truncation_per_depth non-negative)");
+  if (!(params.max_weight >= 1)) fail("max_weight", "must be at least 1");
+  if (params.allocation_stride_px < 1) fail("allocation_stride_px", "must be at least 1");
+  if (params.block_capacity == 0 || params.block_capacity > (std::size_t{1} << 30))
+    fail("block_capacity", "must be in [1, 2^30]");
+  if (!(params.depth_min_m >= 0) || !(params.depth_max_m > params.depth_min_m))
+    fail("depth_max_m", "needs 0 <= depth_min_m < depth_max_m");
+}
+
+}  // namespace glint::fusion

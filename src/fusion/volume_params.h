@@ -1,0 +1,38 @@
+#pragma once
+// Parameters of the voxel-hashed TSDF volume (VoxelHashing, Niessner et al. 2013; paper 1 §3.3).
+#include <cstddef>
+
+namespace glint::fusion {
+
+// Voxels per block side: blocks are 8x8x8 voxels (VoxelHashing's SDF_BLOCK_SIZE).
+inline constexpr int kBlockSide = 8;
+inline constexpr int kVoxelsPerBlock = kBlockSide * kBlockSide * kBlockSide;
+
+struct VolumeParams {
+  double voxel_size_m = 0.005;
+  // Truncation band half-width at depth z: truncation_m + truncation_per_depth * z (metres),
+  // VoxelHashing's getTruncation() with its defaults; the band grows with the sensor noise.
+  double truncation_m = 0.02;
+  double truncation_per_depth = 0.01;
+  float max_weight =
+      255;  // the running weight saturates here (VoxelHashing's integrationWeightMax)
+  // Fixed pool: at most this many blocks (10 KiB each); memory is committed as blocks are used.
+  // Running out throws glint::Error (fusion/voxel_block_hash.h).
+  std::size_t block_capacity = std::size_t{1} << 18;
+  // Every n-th pixel of every n-th row allocates blocks along its ray (Open3D's DepthTouch uses
+  // 4): neighbouring rays' truncation bands overlap by far more than n pixels at block scale.
+  int allocation_stride_px = 4;
+  // Depth measurements outside [depth_min_m, depth_max_m] are ignored.
+  double depth_min_m = 0.1;
+  double depth_max_m = 4.0;
+
+  double block_size_m() const { return voxel_size_m * kBlockSide; }
+  double truncation_at(double depth_m) const {
+    return truncation_m + truncation_per_depth * depth_m;
+  }
+};
+
+// Throws glint::Error naming the bad parameter (non-positive sizes, depth range, capacity).
+void validate(const VolumeParams& params);
+
+}  // namespace glint::fusion

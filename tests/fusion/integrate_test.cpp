@@ -1,0 +1,108 @@
+// TSDF integration against analytic signed distances.
+#include "fusion/integrate.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/error.h"
+#include "support/error_of.h"
+
+namespace glint::fusion {
+namespace {
+
+const Intrinsics kCamera{64, 48, 50.0, 50.0, 31.5, 23.5};
+
+VolumeParams plane_params() {
+  VolumeParams params;
+  params.voxel_size_m = 0.01;
+  params.truncation_m = 0.04;
+  params.truncation_per_depth = 0.0;
+  params.block_capacity = 4096;
+  return params;
+}
+
+// Camera at the origin looking down +z at the wall z = wall_m: every pixel sees depth wall_m.
+ImageF wall_depth(double wall_m) { return ImageF(kCamera.width, kCamera.height, 1, float(wall_m)); }
+
+TEST(Integrate, FrontoParallelPlaneGivesTheAnalyticSdf) {
+  TsdfVolume volume(plane_params());
+  VisibleBlocks visible;
+  integrate(volume, wall_depth(1.0), ImageF(), kCamera, Pose::Identity(), visible);
+  ASSERT_GT(visible.indices.size(), 0u);
+  EXPECT_EQ(visible.indices.size(), volume.block_count());
+
+  int checked = 0;
+  for (int block : visible.indices) {
+    const Eigen::Vector3i first = volume.hash().block(block) * kBlockSide;
+    for (int v = 0; v < kVoxelsPerBlock; ++v) {
+      const Eigen::Vector3d p =
+          (first + Eigen::Vector3i(v % 8, (v / 8) % 8, v / 64)).cast<double>() * 0.01;
+      const Eigen::Vector2d pixel = kCamera.project(p);
+      const bool in_view = p.z() > 0 && pixel.x() > 0 && pixel.y() > 0 &&
+                           pixel.x() < kCamera.width - 1 && pixel.y() < kCamera.height - 1;
+      const double sdf = 1.0 - p.z();
+      if (!in_view) continue;
+      if (sdf < -0.04 - 1e-6) {
+        EXPECT_EQ(volume.weight(block)[v], 0.0f) << "behind the band: never observed";
+        continue;
+      }
+      if (sdf < -0.04 + 1e-6) continue;
+      EXPECT_EQ(volume.weight(block)[v], 1.0f);
+      EXPECT_NEAR(volume.sdf_m(block)[v], std::min(sdf, 0.04), 1e-5) << p.transpose();
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 1000);
+}
+
+TEST(Integrate, RepeatedFramesAverageAndColourFollows) {
+  TsdfVolume volume(plane_params());
+  VisibleBlocks visible;
+  ImageF colour(kCamera.width, kCamera.height, 3, 0.25f);
+  integrate(volume, wall_depth(1.0), colour, kCamera, Pose::Identity(), visible);
+  colour.values().assign(colour.values().size(), 0.75f);
+  integrate(volume, wall_depth(1.02), colour, kCamera, Pose::Identity(), visible);
+  const int block = volume.hash().find({0, 0, 12});  // voxels z = 0.96 .. 1.03 m
+  ASSERT_GE(block, 0);
+  const int voxel = 3 * 64;  // (0, 0, z = 0.99 m)
+  EXPECT_EQ(volume.weight(block)[voxel], 2.0f);
+  EXPECT_NEAR(volume.sdf_m(block)[voxel], 0.5 * (0.01 + 0.03), 1e-5);
+  EXPECT_NEAR(volume.red(block)[voxel], 0.5, 1e-6);
+}
+
+TEST(Integrate, ExhaustedPoolIsAClearError) {
+  VolumeParams params = plane_params();
+  params.block_capacity = 5;
+  TsdfVolume volume(params);
+  VisibleBlocks visible;
+  const Error error = test::error_of(
+      [&] { integrate(volume, wall_depth(1.0), ImageF(), kCamera, Pose::Identity(), visible); });
+  EXPECT_NE(error.reason().find("all 5 blocks are in use"), std::string::npos) << error.what();
+  EXPECT_EQ(volume.block_count(), 5u);
+}
+
+TEST(Integrate, MismatchedImagesAndBadParametersAreErrors) {
+  TsdfVolume volume(plane_params());
+  VisibleBlocks visible;
+  EXPECT_THROW(
+      integrate(volume, ImageF(10, 10, 1, 1.0f), ImageF(), kCamera, Pose::Identity(), visible),
+      Error);
+  EXPECT_THROW(
+      integrate(volume, wall_depth(1.0), ImageF(8, 8, 3), kCamera, Pose::Identity(), visible),
+      Error);
+  VolumeParams bad = plane_params();
+  bad.voxel_size_m = 0;
+  EXPECT_THROW(TsdfVolume{bad}, Error);
+}
+
+TEST(Integrate, ZeroDepthIsNoMeasurement) {
+  TsdfVolume volume(plane_params());
+  VisibleBlocks visible;
+  integrate(volume, wall_depth(0.0), ImageF(), kCamera, Pose::Identity(), visible);
+  EXPECT_EQ(volume.block_count(), 0u);
+  EXPECT_TRUE(visible.indices.empty());
+}
+
+}  // namespace
+}  // namespace glint::fusion

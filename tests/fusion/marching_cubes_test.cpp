@@ -1,0 +1,90 @@
+#include "fusion/marching_cubes.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numbers>
+
+#include "fusion/marching_cubes_table.h"
+#include "fusion_test_support.h"
+
+namespace glint::fusion {
+namespace {
+
+TEST(MarchingCubesTable, SingleCornerCasesAreOneOutwardTriangle) {
+  const auto& cases = marching_cubes_cases();
+  EXPECT_EQ(cases[0].triangle_count, 0);
+  EXPECT_EQ(cases[255].triangle_count, 0);
+  // Corner 0 inside: the triangle on edges x0, y0, z0 faces away from it, towards +(1,1,1).
+  ASSERT_EQ(cases[1].triangle_count, 1);
+  Eigen::Vector3d v[3];
+  for (int k = 0; k < 3; ++k) {
+    const CubeEdge& edge = kCubeEdges[cases[1].edges[k]];
+    EXPECT_EQ(edge.corner, 0);
+    v[k] = Eigen::Vector3d::Zero();
+    v[k][edge.axis] = 0.5;
+  }
+  EXPECT_GT((v[1] - v[0]).cross(v[2] - v[0]).dot(Eigen::Vector3d(1, 1, 1)), 0);
+  for (int c = 0; c < 8; ++c) EXPECT_EQ(cases[1 << c].triangle_count, 1);
+}
+
+TEST(MarchingCubes, SphereAreaAndVolumeWithinOnePercent) {
+  VolumeParams params;
+  params.voxel_size_m = 0.01;
+  params.block_capacity = 20000;
+  TsdfVolume volume(params);
+  const double radius = 0.3;
+  const Eigen::Vector3d centre(0.013, -0.021, 0.007);
+  test::fill_analytic(
+      volume, [&](const Eigen::Vector3d& p) { return (p - centre).norm() - radius; }, 0.4, 0.04);
+  const TriangleMesh mesh = extract_mesh(volume);
+  ASSERT_GT(mesh.triangles.size(), 1000u);
+  const double area = 4 * std::numbers::pi * radius * radius;
+  const double enclosed = 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
+  EXPECT_NEAR(surface_area(mesh) / area, 1.0, 0.01);
+  EXPECT_NEAR(enclosed_volume(mesh) / enclosed, 1.0, 0.01);
+  for (const Eigen::Vector3f& v : mesh.vertices)
+    ASSERT_NEAR((v.cast<double>() - centre).norm(), radius, 0.002);
+
+  // Closed and manifold: every undirected edge is used by exactly two triangles, once in each
+  // direction.
+  std::map<std::pair<int, int>, int> directed;
+  for (const Eigen::Vector3i& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
+  for (const auto& [edge, count] : directed) {
+    ASSERT_EQ(count, 1);
+    ASSERT_EQ(directed.count({edge.second, edge.first}), 1u);
+  }
+}
+
+TEST(MarchingCubes, UnobservedVoxelsEmitNothing) {
+  TsdfVolume volume;
+  EXPECT_TRUE(extract_mesh(volume).triangles.empty());
+  const int block = volume.allocate({0, 0, 0});
+  volume.sdf_m(block)[0] = -0.01f;  // weight still 0
+  EXPECT_TRUE(extract_mesh(volume).vertices.empty());
+}
+
+TEST(MarchingCubes, PlyOutputHasHeaderCountsAndColours) {
+  TriangleMesh mesh;
+  mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  mesh.colours = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  mesh.triangles = {{0, 1, 2}};
+  const std::string path = ::testing::TempDir() + "/triangle.ply";
+  write_mesh_ply(path, mesh);
+  std::ifstream in(path, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_NE(text.find("element vertex 3"), std::string::npos);
+  EXPECT_NE(text.find("element face 1"), std::string::npos);
+  EXPECT_NE(text.find("property uchar red"), std::string::npos);
+  const std::size_t body = text.find("end_header\n") + 11;
+  EXPECT_EQ(text.size() - body, 3 * 15 + 13u);
+  EXPECT_EQ(linear_to_srgb8(1.0f), 255);
+  EXPECT_EQ(linear_to_srgb8(0.2158605f), 128);
+}
+
+}  // namespace
+}  // namespace glint::fusion
