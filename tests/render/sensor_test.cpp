@@ -35,7 +35,8 @@ TEST(Sensor, EightBitColourClipsHighlightsAndQuantises) {
     EXPECT_FLOAT_EQ(colour.at(1, 0, c), 1.0f);
     EXPECT_FLOAT_EQ(colour.at(2, 0, c), 1.0f);
   }
-  for (float value : expose_colour(ramp(64, 32, 3.0f), camera, 1, 0).values()) {
+  const ImageF ramp_colour = expose_colour(ramp(64, 32, 3.0f), camera, 1, 0);
+  for (float value : ramp_colour.values()) {
     EXPECT_GE(value, 0.0f);
     EXPECT_LE(value, 1.0f);
     EXPECT_FLOAT_EQ(value * 255, std::round(value * 255));
