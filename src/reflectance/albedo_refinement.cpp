@@ -27,28 +27,33 @@ std::optional<Eigen::Vector3f> refine_albedo(const Observation* observations, in
                                              const Eigen::Vector3f& normal,
                                              const std::vector<render::PointLight>& lights,
                                              const Eigen::Vector3f& ks, float alpha) {
-  // The denominator of eq. (7) depends on the lights only, not on the observation.
-  Eigen::Vector3f diffuse = Eigen::Vector3f::Zero();
-  for (const render::PointLight& light : lights)
-    diffuse += incidence(light, position, normal).irradiance;
-  if (diffuse.minCoeff() <= 1e-12f) return std::nullopt;
-
-  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  // Eq. (7) is linear in B_k and in the specular sum, so its mean over the observations is
+  // eq. (7) of the mean colour and the mean specular sum: each light's incidence is computed
+  // once per voxel, not once per observation.
+  Eigen::Vector3f colour_sum = Eigen::Vector3f::Zero();
   int used = 0;
-  for (int k = 0; k < count; ++k) {
-    const Eigen::Vector3f& wo = observations[k].direction;
-    if (normal.dot(wo) <= 0.0f) continue;
-    Eigen::Vector3f specular = Eigen::Vector3f::Zero();
-    for (const render::PointLight& light : lights) {
-      const Incidence in = incidence(light, position, normal);
-      specular += in.irradiance * render::ward_specular_lobe(normal, in.direction, wo, alpha);
+  for (int k = 0; k < count; ++k)
+    if (normal.dot(observations[k].direction) > 0.0f) {
+      colour_sum += observations[k].colour;
+      ++used;
     }
-    sum +=
-        float(M_PI) * (observations[k].colour - ks.cwiseProduct(specular)).cwiseQuotient(diffuse);
-    ++used;
-  }
   if (used == 0) return std::nullopt;
-  return sum / float(used);
+
+  Eigen::Vector3f diffuse = Eigen::Vector3f::Zero();   // sum_l L_l cos
+  Eigen::Vector3f specular = Eigen::Vector3f::Zero();  // sum_k sum_l exp(gamma)/N L_l cos
+  for (const render::PointLight& light : lights) {
+    const Incidence in = incidence(light, position, normal);
+    diffuse += in.irradiance;
+    float lobe_sum = 0.0f;
+    for (int k = 0; k < count; ++k)
+      if (normal.dot(observations[k].direction) > 0.0f)
+        lobe_sum +=
+            render::ward_specular_lobe(normal, in.direction, observations[k].direction, alpha);
+    specular += in.irradiance * lobe_sum;
+  }
+  if (diffuse.minCoeff() <= 1e-12f) return std::nullopt;
+  return float(M_PI) * (colour_sum - ks.cwiseProduct(specular)).cwiseQuotient(diffuse) /
+         float(used);
 }
 
 }  // namespace glint::reflectance

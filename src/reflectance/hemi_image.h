@@ -27,7 +27,7 @@ Eigen::Vector2f project_to_disk(const Eigen::Vector3f& local_direction, HemiProj
 
 // Writes size*size*3 floats, channel-major (CHW) like the network's input, into `out`.
 // Observations below the surface (direction . normal <= 0) are ignored; with none left the
-// image is black. No allocation.
+// image is black. At most the first 256 observations are used. No allocation.
 void make_hemi_image(const Observation* observations, int count, const Eigen::Vector3f& normal,
                      const HemiImageParams& params, float* out);
 
