@@ -20,9 +20,8 @@ ImageF run_dip(const torch::Tensor& noisy, const ImageF* guidance, const NeuralP
       pad_to_multiple(torch::zeros({1, params.input_channels, height, width}, noisy.options()),
                       multiple)
           .uniform_(0.0, params.input_scale);
-  // Base of eq. (16)'s decay, per pixel: 0.9 + 0.1 m.
-  const torch::Tensor decay_base =
-      guidance ? 0.9 + 0.1 * to_tensor(*guidance, noisy.device()) : torch::Tensor();
+  const torch::Tensor importance =
+      guidance ? to_tensor(*guidance, noisy.device()) : torch::Tensor();
 
   torch::Tensor average;
   ProgressBar progress(method_name(params.method), static_cast<std::size_t>(params.iterations));
@@ -31,12 +30,9 @@ ImageF run_dip(const torch::Tensor& noisy, const ImageF* guidance, const NeuralP
     const torch::Tensor perturbed = input + torch::randn_like(input) * params.input_perturbation;
     const torch::Tensor output = crop_to(net->forward(perturbed, {}), height, width);
     torch::Tensor residual = output - noisy;
-    if (decay_base.defined() && i >= params.decay.warmup) {
-      // eq. (16): w = base^((i − κw)·κr)·(1 − κc) + κc; eq. (15): mean of (residual·w)².
-      const double exponent = (i - params.decay.warmup) * params.decay.rate;
-      residual =
-          residual * (decay_base.pow(exponent) * (1.0 - params.decay.floor) + params.decay.floor);
-    }
+    // eq. (15): mean of (residual·w)², w of eq. (16) (1 during the warm-up).
+    if (importance.defined() && i >= params.decay.warmup)
+      residual = residual * decayed_weight(i, importance, params.decay);
     residual.pow(2).mean().backward();
     optimiser.step();
     // eq. (14): exponential average of the outputs.
