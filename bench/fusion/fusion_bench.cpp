@@ -44,7 +44,7 @@ std::string cpu_model() {
 }
 
 nlohmann::json summary_of(const std::vector<double>& ms) {
-  fusion::FrameTimings timings;
+  StageTimings timings;
   for (double value : ms) timings.add("stage", value);
   return timings.to_json()["stage"];
 }

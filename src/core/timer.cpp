@@ -1,6 +1,7 @@
 #include "core/timer.h"
 
 #include <algorithm>
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <numeric>
 
@@ -14,6 +15,14 @@ double median_of(std::vector<double> values) {
   if (values.size() % 2 == 1) return values[mid];
   const double upper = values[mid];
   return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + mid));
+}
+
+// Nearest-rank q-quantile (q in [0, 1]).
+double quantile_of(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  const auto rank = static_cast<std::size_t>(std::lround(q * double(values.size() - 1)));
+  std::nth_element(values.begin(), values.begin() + rank, values.end());
+  return values[rank];
 }
 
 }  // namespace
@@ -40,6 +49,7 @@ nlohmann::json StageTimings::to_json() const {
                   {"total", total},
                   {"median", median_of(values)},
                   {"mean", total / static_cast<double>(values.size())},
+                  {"p90", quantile_of(values, 0.9)},
                   {"max", *std::max_element(values.begin(), values.end())}};
   }
   return out;

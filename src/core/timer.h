@@ -22,7 +22,8 @@ class Stopwatch {
   std::chrono::steady_clock::time_point start_;
 };
 
-// Collects durations per stage name; report as JSON {stage: {count, total, median, mean, max}}.
+// Collects durations per stage name; report as JSON
+// {stage: {count, total, median, mean, p90 (nearest rank), max}} in milliseconds.
 class StageTimings {
  public:
   void add(const std::string& stage, double milliseconds);

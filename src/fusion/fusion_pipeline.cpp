@@ -1,7 +1,6 @@
 #include "fusion/fusion_pipeline.h"
 
 #include "core/error.h"
-#include "core/timer.h"
 
 namespace glint::fusion {
 

@@ -6,7 +6,7 @@
 #include <optional>
 
 #include "core/camera.h"
-#include "fusion/frame_timings.h"
+#include "core/timer.h"
 #include "fusion/icp_tracker.h"
 #include "fusion/integrate.h"
 #include "fusion/raycast.h"
@@ -39,7 +39,7 @@ class FusionPipeline {
   FrameResult process(const io::RgbdFrame& frame);
 
   const TsdfVolume& volume() const { return volume_; }
-  const FrameTimings& timings() const { return timings_; }
+  const StageTimings& timings() const { return timings_; }
 
  private:
   Pose predict_pose() const;
@@ -48,7 +48,7 @@ class FusionPipeline {
   FusionParams params_;
   TsdfVolume volume_;
   VisibleBlocks visible_;
-  FrameTimings timings_;
+  StageTimings timings_;
   SurfaceView model_;
   std::vector<Pose> poses_;
 };

@@ -35,14 +35,14 @@ class BlockNeighbourhood {
   bool get(int x, int y, int z, float& sdf) const {
     const int block = blocks_[(x >> 3) | ((y >> 3) << 1) | ((z >> 3) << 2)];
     if (block < 0) return false;
-    const int voxel = ((z & 7) * kBlockSide + (y & 7)) * kBlockSide + (x & 7);
+    const int voxel = voxel_in_block(x, y, z);
     if (volume_.weight(block)[voxel] <= 0) return false;
     sdf = volume_.sdf_m(block)[voxel];
     return true;
   }
   Eigen::Vector3f colour(int x, int y, int z) const {
     const int block = blocks_[(x >> 3) | ((y >> 3) << 1) | ((z >> 3) << 2)];
-    const int voxel = ((z & 7) * kBlockSide + (y & 7)) * kBlockSide + (x & 7);
+    const int voxel = voxel_in_block(x, y, z);
     return {volume_.red(block)[voxel], volume_.green(block)[voxel], volume_.blue(block)[voxel]};
   }
 

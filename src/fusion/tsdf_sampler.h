@@ -44,7 +44,7 @@ class TsdfSampler {
     float unused;
     const int x = round_to_int(v.x()), y = round_to_int(v.y()), z = round_to_int(v.z());
     if (voxel(x, y, z, unused) != Sample::observed) return Eigen::Vector3f::Zero();
-    const int index = local_index(x, y, z);
+    const int index = voxel_in_block(x, y, z);
     return {volume_.red(block_)[index], volume_.green(block_)[index], volume_.blue(block_)[index]};
   }
 
@@ -57,7 +57,7 @@ class TsdfSampler {
       block_ = volume_.hash().find(block);
     }
     if (block_ < 0) return Sample::unallocated;
-    const int index = local_index(x, y, z);
+    const int index = voxel_in_block(x, y, z);
     if (volume_.weight(block_)[index] <= 0) return Sample::unobserved;
     sdf_m = volume_.sdf_m(block_)[index];
     return Sample::observed;
@@ -65,9 +65,6 @@ class TsdfSampler {
 
  private:
   static int round_to_int(float value) { return static_cast<int>(std::floor(value + 0.5f)); }
-  static int local_index(int x, int y, int z) {
-    return ((z & 7) * kBlockSide + (y & 7)) * kBlockSide + (x & 7);
-  }
 
   const TsdfVolume& volume_;
   float inverse_voxel_;

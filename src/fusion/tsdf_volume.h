@@ -12,10 +12,17 @@
 #include <memory>
 #include <vector>
 
+#include "fusion/host_device.h"
 #include "fusion/volume_params.h"
 #include "fusion/voxel_block_hash.h"
 
 namespace glint::fusion {
+
+// Index within its block of the voxel at global voxel coordinates (x, y, z) (any sign).
+GLINT_HOST_DEVICE inline int voxel_in_block(int x, int y, int z) {
+  return ((z & (kBlockSide - 1)) * kBlockSide + (y & (kBlockSide - 1))) * kBlockSide +
+         (x & (kBlockSide - 1));
+}
 
 class TsdfVolume {
  public:

@@ -1,6 +1,7 @@
 // 7-Scenes / tsdf-fusion frame folders (Shotton et al. 2013; github.com/andyzeng/tsdf-fusion).
 #include <algorithm>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
 #include "io/rgbd_parsing.h"
@@ -47,9 +48,9 @@ RgbdSequence open_7scenes_sequence(const std::string& folder) {
   sequence.format = "7scenes";
   sequence.depth_units_per_metre = 1000;
   // The K file has no image size: it is the first depth image's.
-  int width = 0, height = 0;
-  rgbd::image_size(rgbd::join(frames, stems.front() + ".depth.png"), width, height);
-  sequence.intrinsics = read_camera_intrinsics(folder, frames, width, height);
+  const cv::Mat first_depth =
+      rgbd::decode_image(rgbd::join(frames, stems.front() + ".depth.png"), cv::IMREAD_UNCHANGED);
+  sequence.intrinsics = read_camera_intrinsics(folder, frames, first_depth.cols, first_depth.rows);
   for (const std::string& stem : stems) {
     RgbdFrameFiles frame;
     frame.depth_path = rgbd::join(frames, stem + ".depth.png");

@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <Eigen/SVD>
-#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
@@ -76,32 +75,16 @@ Pose pose_from_matrix(const std::string& path, const std::string& element,
   return pose;
 }
 
-std::optional<Pose> nearest_pose(const std::vector<StampedPose>& poses, double timestamp_s,
-                                 double max_difference_s) {
-  const auto after =
-      std::lower_bound(poses.begin(), poses.end(), timestamp_s,
-                       [](const StampedPose& p, double t) { return p.timestamp < t; });
-  const StampedPose* best = nullptr;
-  if (after != poses.end()) best = &*after;
-  if (after != poses.begin()) {
-    const StampedPose& before = *(after - 1);
-    if (!best || timestamp_s - before.timestamp < best->timestamp - timestamp_s) best = &before;
-  }
-  if (!best || std::abs(best->timestamp - timestamp_s) > max_difference_s) return std::nullopt;
-  return best->pose;
-}
-
-void image_size(const std::string& path, int& width, int& height) {
-  require_file(path, "image");
+cv::Mat decode_image(const std::string& path, int flags) {
+  require_file(path, "the image");
   cv::Mat image;
   try {
-    image = cv::imread(path, cv::IMREAD_UNCHANGED);
+    image = cv::imread(path, flags);
   } catch (const cv::Exception& e) {
     throw Error(path, "", "cannot decode the image: " + e.err);
   }
   if (image.empty()) throw Error(path, "", "not a readable image (corrupt or truncated)");
-  width = image.cols;
-  height = image.rows;
+  return image;
 }
 
 std::string join(const std::string& folder, const std::string& relative) {

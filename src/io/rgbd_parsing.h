@@ -1,7 +1,9 @@
 #pragma once
 // Small text-parsing helpers shared by the RGB-D sequence readers (rgbd_*.cpp).
 #include <Eigen/Core>
-#include <optional>
+#include <algorithm>
+#include <cmath>
+#include <opencv2/core/mat.hpp>
 #include <string>
 #include <vector>
 
@@ -29,12 +31,24 @@ Eigen::MatrixXd parse_matrix(const std::string& path, const std::vector<TextRow>
 Pose pose_from_matrix(const std::string& path, const std::string& element,
                       const Eigen::Matrix4d& matrix);
 
-// The pose nearest in time to `timestamp_s` within `max_difference_s`, if any. `poses` sorted.
-std::optional<Pose> nearest_pose(const std::vector<StampedPose>& poses, double timestamp_s,
-                                 double max_difference_s);
+// The element of `sorted` (ascending in its member `time`, seconds) nearest in time to
+// `timestamp_s` within `max_difference_s` (the later one on a tie), or nullptr.
+template <class Stamped>
+const Stamped* nearest_in_time(const std::vector<Stamped>& sorted, double Stamped::*time,
+                               double timestamp_s, double max_difference_s) {
+  const auto after = std::ranges::lower_bound(sorted, timestamp_s, {}, time);
+  const Stamped* best = after != sorted.end() ? &*after : nullptr;
+  if (after != sorted.begin()) {
+    const Stamped& before = *(after - 1);
+    if (!best || timestamp_s - before.*time < best->*time - timestamp_s) best = &before;
+  }
+  if (!best || std::abs(best->*time - timestamp_s) > max_difference_s) return nullptr;
+  return best;
+}
 
-// Width and height of an image file (decoded once); throws glint::Error naming it when unreadable.
-void image_size(const std::string& path, int& width, int& height);
+// Decodes an image file with cv::imread `flags`; throws glint::Error naming it when it is
+// missing or unreadable.
+cv::Mat decode_image(const std::string& path, int flags);
 
 // folder / relative, as a string.
 std::string join(const std::string& folder, const std::string& relative);

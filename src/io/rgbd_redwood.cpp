@@ -1,6 +1,7 @@
 // Redwood / Open3D RGB-D folders (redwood-data.org/indoor/fileformat.html).
 #include <algorithm>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
 #include "io/json_report.h"
@@ -78,8 +79,8 @@ RgbdSequence open_redwood_sequence(const std::string& folder) {
   if (rgbd::exists(intrinsics_path)) {
     sequence.intrinsics = read_open3d_intrinsics(intrinsics_path);
   } else {  // PrimeSense defaults (Open3D's PinholeCameraIntrinsicParameters::PrimeSenseDefault)
-    sequence.intrinsics = {640, 480, 525, 525, 319.5, 239.5};
-    rgbd::image_size(depths.front(), sequence.intrinsics.width, sequence.intrinsics.height);
+    const cv::Mat first_depth = rgbd::decode_image(depths.front(), cv::IMREAD_UNCHANGED);
+    sequence.intrinsics = {first_depth.cols, first_depth.rows, 525, 525, 319.5, 239.5};
   }
   const std::string log_path = rgbd::join(folder, "trajectory.log");
   const std::vector<Pose> poses =

@@ -5,7 +5,6 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
-#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
@@ -23,18 +22,6 @@ bool has_7scenes_frames(const std::string& folder) {
     }
   }
   return false;
-}
-
-cv::Mat read_unchanged(const std::string& path, int flags) {
-  if (!std::filesystem::is_regular_file(path)) throw Error(path, "", "the image is missing");
-  cv::Mat image;
-  try {
-    image = cv::imread(path, flags);
-  } catch (const cv::Exception& e) {
-    throw Error(path, "", "cannot decode the image: " + e.err);
-  }
-  if (image.empty()) throw Error(path, "", "not a readable image (corrupt or truncated)");
-  return image;
 }
 
 void require_size(const std::string& path, const cv::Mat& image, const Intrinsics& k) {
@@ -58,7 +45,7 @@ const std::array<float, 256>& srgb_to_linear_table() {
 }
 
 ImageF read_depth(const std::string& path, const RgbdSequence& sequence) {
-  const cv::Mat raw = read_unchanged(path, cv::IMREAD_ANYDEPTH);
+  const cv::Mat raw = rgbd::decode_image(path, cv::IMREAD_ANYDEPTH);
   if (raw.type() != CV_16UC1) throw Error(path, "", "expected a 16-bit single-channel depth image");
   require_size(path, raw, sequence.intrinsics);
   ImageF depth(raw.cols, raw.rows, 1);
@@ -75,7 +62,7 @@ ImageF read_depth(const std::string& path, const RgbdSequence& sequence) {
 }
 
 ImageF read_colour(const std::string& path, const RgbdSequence& sequence) {
-  const cv::Mat bgr = read_unchanged(path, cv::IMREAD_COLOR);
+  const cv::Mat bgr = rgbd::decode_image(path, cv::IMREAD_COLOR);
   require_size(path, bgr, sequence.intrinsics);
   const auto& linear = srgb_to_linear_table();
   ImageF colour(bgr.cols, bgr.rows, 3);

@@ -54,23 +54,12 @@ std::vector<RgbdFrameFiles> read_associations(const std::string& folder) {
 std::vector<RgbdFrameFiles> associate_lists(const std::string& folder) {
   std::vector<StampedFile> colours = read_file_list(folder, "rgb.txt");
   const std::vector<StampedFile> depths = read_file_list(folder, "depth.txt");
-  std::sort(colours.begin(), colours.end(), [](const StampedFile& a, const StampedFile& b) {
-    return a.timestamp_s < b.timestamp_s;
-  });
+  std::ranges::sort(colours, {}, &StampedFile::timestamp_s);
   std::vector<RgbdFrameFiles> frames;
   for (const StampedFile& depth : depths) {
-    const auto after =
-        std::lower_bound(colours.begin(), colours.end(), depth.timestamp_s,
-                         [](const StampedFile& c, double t) { return c.timestamp_s < t; });
-    const StampedFile* best = nullptr;
-    for (auto it : {after, after == colours.begin() ? colours.end() : after - 1}) {
-      if (it == colours.end()) continue;
-      if (!best || std::abs(it->timestamp_s - depth.timestamp_s) <
-                       std::abs(best->timestamp_s - depth.timestamp_s))
-        best = &*it;
-    }
-    if (best && std::abs(best->timestamp_s - depth.timestamp_s) <= kMaxTimeDifferenceS)
-      frames.push_back({best->path, depth.path, depth.timestamp_s, std::nullopt});
+    if (const StampedFile* colour = rgbd::nearest_in_time(colours, &StampedFile::timestamp_s,
+                                                          depth.timestamp_s, kMaxTimeDifferenceS))
+      frames.push_back({colour->path, depth.path, depth.timestamp_s, std::nullopt});
   }
   return frames;
 }
@@ -79,10 +68,12 @@ void attach_ground_truth(const std::string& folder, std::vector<RgbdFrameFiles>&
   const std::string path = rgbd::join(folder, "groundtruth.txt");
   if (!rgbd::exists(path)) return;
   std::vector<StampedPose> poses = read_tum_trajectory(path);
-  std::sort(poses.begin(), poses.end(),
-            [](const StampedPose& a, const StampedPose& b) { return a.timestamp < b.timestamp; });
-  for (RgbdFrameFiles& frame : frames)
-    frame.ground_truth = rgbd::nearest_pose(poses, frame.timestamp_s, kMaxTimeDifferenceS);
+  std::ranges::sort(poses, {}, &StampedPose::timestamp);
+  for (RgbdFrameFiles& frame : frames) {
+    if (const StampedPose* nearest = rgbd::nearest_in_time(poses, &StampedPose::timestamp,
+                                                           frame.timestamp_s, kMaxTimeDifferenceS))
+      frame.ground_truth = nearest->pose;
+  }
 }
 
 void require_images(const std::vector<RgbdFrameFiles>& frames) {
@@ -123,8 +114,8 @@ RgbdSequence open_glint_sequence(const std::string& folder) {
   sequence.folder = folder;
   sequence.format = "glint";
   const std::string intrinsics_path = rgbd::join(folder, "intrinsics.json");
-  sequence.intrinsics = read_intrinsics_json(intrinsics_path);
   const nlohmann::json json = read_json(intrinsics_path);
+  sequence.intrinsics = intrinsics_from_json(json, intrinsics_path);
   if (json.contains("depth_scale")) {
     if (!json["depth_scale"].is_number() || json["depth_scale"].get<double>() <= 0)
       throw Error(intrinsics_path, "depth_scale", "must be a positive number");

@@ -2,35 +2,27 @@
 
 #include <fmt/format.h>
 
-#include <cmath>
-#include <sstream>
+#include <nlohmann/json.hpp>
 
 #include "core/error.h"
 #include "io/atomic_file.h"
-#include "io/file_bytes.h"
 #include "io/json_report.h"
+#include "io/rgbd_parsing.h"
 
 namespace glint::io {
 
 std::vector<StampedPose> read_tum_trajectory(const std::string& path) {
-  std::istringstream text(read_file_bytes(path));
   std::vector<StampedPose> poses;
-  std::string line;
-  for (int line_number = 1; std::getline(text, line); ++line_number) {
-    const auto first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
-    std::istringstream fields(line);
+  for (const rgbd::TextRow& row : rgbd::read_rows(path)) {
+    const std::string element = "line " + std::to_string(row.line);
+    if (row.fields.size() < 8)
+      throw Error(path, element, "expected 8 finite numbers 'timestamp tx ty tz qx qy qz qw'");
     double v[8];
-    for (double& value : v) {
-      if (!(fields >> value) || !std::isfinite(value))
-        throw Error(path, "line " + std::to_string(line_number),
-                    "expected 8 finite numbers 'timestamp tx ty tz qx qy qz qw'");
-    }
-    Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+    for (std::size_t i = 0; i < 8; ++i) v[i] = rgbd::parse_number(path, row, i);
+    const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
     const double norm = q.norm();
     if (norm < 0.9 || norm > 1.1)
-      throw Error(path, "line " + std::to_string(line_number),
-                  fmt::format("quaternion has length {:.4g}, not 1", norm));
+      throw Error(path, element, fmt::format("quaternion has length {:.4g}, not 1", norm));
     StampedPose stamped;
     stamped.timestamp = v[0];
     stamped.pose.linear() = q.normalized().toRotationMatrix();
@@ -53,7 +45,10 @@ void write_tum_trajectory(const std::string& path, const std::vector<StampedPose
 }
 
 Intrinsics read_intrinsics_json(const std::string& path) {
-  const nlohmann::json json = read_json(path);
+  return intrinsics_from_json(read_json(path), path);
+}
+
+Intrinsics intrinsics_from_json(const nlohmann::json& json, const std::string& path) {
   Intrinsics k;
   try {
     k.width = json.at("width").get<int>();

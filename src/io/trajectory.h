@@ -4,6 +4,7 @@
 //    metres, unit quaternion), '#' comment lines ignored (Sturm et al. 2012).
 //  - intrinsics.json: {"width", "height", "fx", "fy", "cx", "cy"} (glint's sequence format),
 //    extra keys (e.g. "depth_scale") are left to the caller.
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,8 @@ std::vector<StampedPose> read_tum_trajectory(const std::string& path);
 void write_tum_trajectory(const std::string& path, const std::vector<StampedPose>& poses);
 
 Intrinsics read_intrinsics_json(const std::string& path);
+// The same from an already parsed file (`path` names it in errors).
+Intrinsics intrinsics_from_json(const nlohmann::json& json, const std::string& path);
 void write_intrinsics_json(const std::string& path, const Intrinsics& intrinsics);
 
 }  // namespace glint::io

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include "core/error.h"
 #include "fusion/marching_cubes.h"
 #include "io/rgbd_sequence.h"
