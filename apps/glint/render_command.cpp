@@ -25,12 +25,6 @@ struct RenderOptions {
   bool no_shadows = false;
 };
 
-// The scene's camera at another resolution, each axis scaled on its own (pixel centres align).
-Intrinsics resized(const Intrinsics& k, int width, int height) {
-  const double sx = double(width) / k.width, sy = double(height) / k.height;
-  return {width, height, k.fx * sx, k.fy * sy, (k.cx + 0.5) * sx - 0.5, (k.cy + 0.5) * sy - 0.5};
-}
-
 void run_render(const RenderOptions& options) {
   render::Scene scene = render::read_scene_json(options.scene_path);
   Intrinsics& intrinsics = scene.camera.intrinsics;
@@ -38,7 +32,7 @@ void run_render(const RenderOptions& options) {
     const double aspect = double(intrinsics.height) / intrinsics.width;
     const int width = options.width.value_or(int(std::lround(*options.height / aspect)));
     const int height = options.height.value_or(int(std::lround(*options.width * aspect)));
-    intrinsics = resized(intrinsics, width, height);
+    intrinsics = intrinsics.resized(width, height);
   }
   if (options.exposure) scene.camera.exposure = *options.exposure;
   if (options.no_shadows) scene.shadows = false;

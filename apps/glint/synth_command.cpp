@@ -59,17 +59,8 @@ nlohmann::json run_training_set(const SynthCommandOptions& options) {
     return report;
   }
   ProgressBar progress("training set", static_cast<std::size_t>(params.sequences));
-  // One bar over the sequences: the bars of the single sequences are created while quiet.
-  const bool was_quiet = is_quiet();
-  set_quiet(true);
-  render::TrainingSetStats stats;
-  try {
-    stats = render::write_training_set(params, options.output, [&] { progress.advance(); });
-  } catch (...) {
-    set_quiet(was_quiet);
-    throw;
-  }
-  set_quiet(was_quiet);
+  const render::TrainingSetStats stats =
+      render::write_training_set(params, options.output, [&] { progress.advance(); });
   progress.finish();
   log().info("{}: {} sequences of {} frames at {}x{} ({} rendered, {} already there) in {:.1f} s",
              options.output, params.sequences, params.frames, params.width, params.height,

@@ -39,6 +39,12 @@ struct Intrinsics {
             (cx + 0.5) * factor - 0.5,
             (cy + 0.5) * factor - 0.5};
   }
+  // The same camera at another image size, each axis scaled on its own (the aspect ratio may
+  // change): pixel centres stay aligned.
+  Intrinsics resized(int new_width, int new_height) const {
+    const double sx = double(new_width) / width, sy = double(new_height) / height;
+    return {new_width, new_height, fx * sx, fy * sy, (cx + 0.5) * sx - 0.5, (cy + 0.5) * sy - 0.5};
+  }
 };
 
 // Kinect v2 depth camera, registered RGB-D at 512x424 (the thesis's sensor; typical factory

@@ -218,13 +218,18 @@ class BinaryBody {
     copy_value(take(size, element, index), slot.column_bytes + index * size, size, swap_);
   }
 
-  void skip_list(const Property& property, const Element& element, std::size_t index) {
+  // Reads the length prefix of a list property.
+  std::size_t list_length(const Property& property, const Element& element, std::size_t index) {
     const double length = value(*property.list_length, element, index);
     if (!is_list_length(length)) {
       throw Error(path_, record_name(element, index), "invalid list length");
     }
     if (length > double(remaining())) truncated(element, index);
-    take(static_cast<std::size_t>(length) * size_of(property.type), element, index);
+    return static_cast<std::size_t>(length);
+  }
+
+  void skip_list(const Property& property, const Element& element, std::size_t index) {
+    take(list_length(property, element, index) * size_of(property.type), element, index);
   }
 
   bool skip_fixed(const Element& element) {
@@ -288,10 +293,18 @@ class AsciiBody {
     store(*slot.column, index, value(slot.property->type, element, index));
   }
 
-  void skip_list(const Property& property, const Element& element, std::size_t index) {
+  // Reads the length prefix of a list property.
+  std::size_t list_length(const Property& property, const Element& element, std::size_t index) {
     const double length = value(*property.list_length, element, index);
     if (!is_list_length(length)) fail(element, index, "invalid list length");
-    for (double item = 0; item < length; ++item) value(property.type, element, index);
+    // Each item needs a token of at least one character.
+    if (length > double(tokens_.remaining())) truncated(element, index);
+    return static_cast<std::size_t>(length);
+  }
+
+  void skip_list(const Property& property, const Element& element, std::size_t index) {
+    const std::size_t length = list_length(property, element, index);
+    for (std::size_t item = 0; item < length; ++item) value(property.type, element, index);
   }
 
   bool skip_fixed(const Element& element) { return is_empty_record(element); }
@@ -397,6 +410,63 @@ PointCloud read_body(const std::string& path, Body& body, const Header& header,
   return read_vertices(path, body, vertex);
 }
 
+// The face element's index list: "vertex_indices", or "vertex_index" as some writers name it.
+const Property& face_list(const std::string& path, const Element& face) {
+  for (const char* name : {"vertex_indices", "vertex_index"}) {
+    const Property* property = face.find(name);
+    if (property && property->list_length) return *property;
+  }
+  throw Error(path, "face", "needs a vertex_indices list");
+}
+
+// Appends the faces' polygons, fan-triangulated, to `triangles`.
+template <class Body>
+void read_faces(const std::string& path, Body& body, const Element& face, std::size_t vertex_count,
+                std::vector<Eigen::Vector3i>& triangles) {
+  const Property& list = face_list(path, face);
+  std::vector<int> polygon;
+  for (std::size_t i = 0; i < face.count; ++i) {
+    for (const Property& property : face.properties) {
+      if (&property != &list) {
+        if (property.list_length) {
+          body.skip_list(property, face, i);
+        } else {
+          body.value(property.type, face, i);
+        }
+        continue;
+      }
+      polygon.resize(body.list_length(property, face, i));
+      for (int& corner : polygon) {
+        const double index = body.value(property.type, face, i);
+        if (!(index >= 0 && index < double(vertex_count))) {
+          throw Error(path, record_name(face, i), "vertex index out of range");
+        }
+        corner = static_cast<int>(index);
+      }
+      for (std::size_t c = 2; c < polygon.size(); ++c) {
+        triangles.emplace_back(polygon[0], polygon[c - 1], polygon[c]);
+      }
+    }
+  }
+}
+
+template <class Body>
+PlyMesh read_mesh_body(const std::string& path, Body& body, const Header& header,
+                       const Element& vertex) {
+  PlyMesh mesh;
+  for (const Element& element : header.elements) {
+    if (&element == &vertex) {
+      mesh.vertices = read_vertices(path, body, vertex);
+    } else if (element.name == "face") {
+      read_faces(path, body, element, vertex.count, mesh.triangles);
+    } else {
+      skip_element(body, element);
+    }
+  }
+  if (mesh.triangles.empty()) throw Error(path, "face", "the mesh has no faces");
+  return mesh;
+}
+
 // The first name that occurs twice, if any.
 std::optional<std::string> duplicate_name(const std::vector<Property>& properties) {
   std::vector<std::string_view> names;
@@ -420,6 +490,22 @@ const Element& vertex_element(const std::string& path, const Header& header) {
     }
   }
   return *vertex;
+}
+
+// Parses the header and calls read(body, header, vertex element) with the reader of the file's
+// encoding.
+template <class Read>
+auto read_with_body(const std::string& path, const Read& read) {
+  const std::string bytes = read_file_bytes(path);
+  const Header header = parse_header(path, bytes);
+  const Element& vertex = vertex_element(path, header);
+  const std::string_view body = std::string_view(bytes).substr(header.body_offset);
+  if (header.format == PlyFormat::ascii) {
+    AsciiBody ascii(path, body);
+    return read(ascii, header, vertex);
+  }
+  BinaryBody binary(path, body, needs_swap(header.format));
+  return read(binary, header, vertex);
 }
 
 // ---- writing
@@ -493,16 +579,15 @@ void write_ascii_body(std::ostream& out, const PointCloud& cloud) {
 }  // namespace
 
 PointCloud read_ply(const std::string& path) {
-  const std::string bytes = read_file_bytes(path);
-  const Header header = parse_header(path, bytes);
-  const Element& vertex = vertex_element(path, header);
-  const std::string_view body = std::string_view(bytes).substr(header.body_offset);
-  if (header.format == PlyFormat::ascii) {
-    AsciiBody ascii(path, body);
-    return read_body(path, ascii, header, vertex);
-  }
-  BinaryBody binary(path, body, needs_swap(header.format));
-  return read_body(path, binary, header, vertex);
+  return read_with_body(path, [&](auto& body, const Header& header, const Element& vertex) {
+    return read_body(path, body, header, vertex);
+  });
+}
+
+PlyMesh read_ply_mesh(const std::string& path) {
+  return read_with_body(path, [&](auto& body, const Header& header, const Element& vertex) {
+    return read_mesh_body(path, body, header, vertex);
+  });
 }
 
 void write_ply(const std::string& path, const PointCloud& cloud, PlyFormat format) {

@@ -9,7 +9,7 @@
 #include <filesystem>
 
 #include "core/error.h"
-#include "render/ply_mesh.h"
+#include "io/ply.h"
 
 namespace glint::render {
 namespace {
@@ -58,6 +58,16 @@ TriangleMesh read_obj_mesh(const std::string& path) {
   }
   if (mesh.triangles.empty()) throw Error(path, "", "the mesh has no triangles");
   if (all_corners_have_uvs) mesh.corner_uvs = std::move(corner_uvs);
+  return mesh;
+}
+
+TriangleMesh read_ply_mesh(const std::string& path) {
+  io::PlyMesh ply = io::read_ply_mesh(path);
+  TriangleMesh mesh;
+  mesh.vertices.reserve(ply.vertices.size());
+  for (std::size_t v = 0; v < ply.vertices.size(); ++v)
+    mesh.vertices.push_back(ply.vertices.point(v));
+  mesh.triangles = std::move(ply.triangles);
   return mesh;
 }
 

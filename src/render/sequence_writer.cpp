@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -109,7 +110,8 @@ SequenceStats write_sequence(const Scene& scene, const std::string& out_dir,
   std::vector<io::StampedPose> groundtruth;
   std::string associations;
   std::vector<double> render_ms, frame_ms;
-  ProgressBar progress("render", static_cast<std::size_t>(count));
+  std::optional<ProgressBar> progress;
+  if (options.progress) progress.emplace("render", static_cast<std::size_t>(count));
   for (int frame = first; frame < first + count; ++frame) {
     Stopwatch frame_watch;
     const Pose& pose = scene.trajectory[frame];
@@ -139,9 +141,9 @@ SequenceStats write_sequence(const Scene& scene, const std::string& out_dir,
         fmt::format("{:.6f} rgb/{}.png {:.6f} depth/{}.png\n", timestamp, name, timestamp, name);
     groundtruth.push_back({timestamp, pose});
     frame_ms.push_back(frame_watch.elapsed_ms());
-    progress.advance();
+    if (progress) progress->advance();
   }
-  progress.finish();
+  if (progress) progress->finish();
 
   io::AtomicFile associations_file((staging / "associations.txt").string(), false);
   associations_file.stream() << associations;

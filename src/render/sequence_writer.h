@@ -15,6 +15,7 @@ struct SequenceOptions {
   int first_frame = 0;       // first trajectory index rendered
   int frame_count = -1;      // frames from first_frame (clamped to the end), -1 = all
   bool ground_truth = true;  // write gt/
+  bool progress = true;      // show a progress bar over the frames (core/progress.h)
 };
 
 struct SequenceStats {

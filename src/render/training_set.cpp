@@ -302,6 +302,7 @@ TrainingSetStats write_training_set(const TrainingSetParams& params, const std::
   TrainingSetStats stats;
   SequenceOptions options;
   options.ground_truth = params.ground_truth;
+  options.progress = false;  // the caller follows the set through on_sequence
   for (int i = 0; i < params.sequences; ++i) {
     const fs::path folder = out / sequence_folder(i);
     if (fs::is_directory(folder)) {

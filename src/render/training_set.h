@@ -85,7 +85,8 @@ struct TrainingSetStats {
 // ranges, and per sequence: folder, shape, material, lights, environment). Complete sequence
 // folders are skipped, so re-running the same command resumes; an OUT/index.json made with
 // other parameters is an error (glint::Error), to keep one set consistent.
-// `on_sequence` (optional) is called after each sequence, rendered or skipped.
+// `on_sequence` (optional) is called after each sequence, rendered or skipped (the sequences
+// show no progress bars of their own; a caller can show one over the set with it).
 TrainingSetStats write_training_set(const TrainingSetParams& params, const std::string& out_dir,
                                     const std::function<void()>& on_sequence = {});
 

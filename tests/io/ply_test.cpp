@@ -100,6 +100,19 @@ TEST(Ply, AsciiSkipsElementsBeforeAndAfterTheVertices) {
   EXPECT_EQ(*cloud.get<std::int16_t>("temperature"), (std::vector<std::int16_t>{-5, 300, 7}));
 }
 
+TEST(Ply, MeshReadsTheFacesOfEitherEncoding) {
+  const PlyMesh ascii = read_ply_mesh(fixture("ascii_faces.ply"));
+  EXPECT_EQ(ascii.vertices.y, (std::vector<float>{0, 0, 2.25f}));
+  EXPECT_EQ(ascii.triangles, (std::vector<Eigen::Vector3i>{{0, 1, 2}}));
+  const PlyMesh binary = read_ply_mesh(fixture("big_endian_double.ply"));
+  EXPECT_EQ(binary.vertices.size(), 4u);
+  EXPECT_EQ(binary.triangles, (std::vector<Eigen::Vector3i>{{0, 1, 2}, {1, 2, 3}}));
+  // A point cloud is no mesh.
+  const std::string path = scratch("points.ply");
+  write_ply(path, ascii.vertices);
+  EXPECT_THAT(error_of([&] { read_ply_mesh(path); }).reason(), HasSubstr("no faces"));
+}
+
 TEST(Ply, BigEndianDoublesWithCrlfHeader) {
   const PointCloud cloud = read_ply(fixture("big_endian_double.ply"));
   ASSERT_EQ(cloud.size(), 4u);
