@@ -4,8 +4,6 @@
 // Writes JSON (stdout, or --json FILE).
 //
 //   denoise_speed [--size 1024] [--net-size 256] [--full-iterations 3] [--json F]
-#include <sys/resource.h>
-
 #include <algorithm>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -20,6 +18,7 @@
 #include "denoise/noise_level.h"
 #include "denoise/test_patterns.h"
 #include "io/json_report.h"
+#include "support/machine.h"
 
 namespace {
 
@@ -126,9 +125,7 @@ int main(int argc, char** argv) {
     result["neural"].push_back(neural_speed(method, "fast", small, guidance, fast_iterations));
     result["neural"].push_back(neural_speed(method, "full", small, guidance, full_iterations));
   }
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  result["peak_rss_mib"] = usage.ru_maxrss / 1024;
+  result["peak_rss_mib"] = bench::peak_rss_mib();
   if (json_path.empty())
     std::cout << result.dump(2) << "\n";
   else

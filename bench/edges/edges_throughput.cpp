@@ -3,8 +3,6 @@
 // Writes JSON (stdout, or --json FILE) with the machine and the parameters it ran with.
 //
 //   edges_throughput [--points 1000000] [--model models/bounded-3c.json] [--data DIR] [--json F]
-#include <sys/resource.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <iostream>
@@ -19,6 +17,7 @@
 #include "edges/synth.h"
 #include "io/json_report.h"
 #include "io/point_cloud_io.h"
+#include "support/machine.h"
 
 namespace {
 
@@ -31,12 +30,6 @@ glint::PointCloud benchmark_cloud(std::size_t n) {
   params.noise_levels = {0.0};
   params.outlier_probability = params.abc_probability = params.gradient_probability = 0.0;
   return glint::edges::synthesize_cloud(params, 0).cloud;
-}
-
-long peak_rss_mib() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_maxrss / 1024;
 }
 
 std::string arg_value(int argc, char** argv, const std::string& name, const std::string& fallback) {
@@ -65,7 +58,7 @@ int main(int argc, char** argv) {
   const glint::edges::Model model = glint::edges::Model::load(model_path);
 
   const glint::PointCloud cloud = benchmark_cloud(points);
-  const long rss_before_mib = peak_rss_mib();
+  const double rss_before_mib = glint::bench::peak_rss_mib();
   const glint::edges::Classification result = glint::edges::classify(cloud, model);
   const double total_s = result.features_s + result.inference_s;
   report["generated"] = {{"points", points},
@@ -73,7 +66,7 @@ int main(int argc, char** argv) {
                          {"inference_s", result.inference_s},
                          {"total_s", total_s},
                          {"points_per_s", double(points) / total_s},
-                         {"peak_rss_mib", peak_rss_mib()},
+                         {"peak_rss_mib", glint::bench::peak_rss_mib()},
                          {"peak_rss_before_features_mib", rss_before_mib}};
 
   const glint::Stopwatch watch;

@@ -8,10 +8,8 @@
 //
 //   fusion_bench --data SEQ [--voxels 0.005,0.01] [--frames N] [--samples 200000]
 //                [--meshes DIR] [--json OUT.json]
-#include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
-#include <fstream>
 #include <iostream>
 #include <thread>
 
@@ -24,24 +22,11 @@
 #include "io/rgbd_sequence.h"
 #include "mesh_distance.h"
 #include "open3d_tsdf.h"
+#include "support/machine.h"
 
 namespace {
 
 using namespace glint;
-
-double peak_resident_mb() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_maxrss / 1024.0;  // ru_maxrss is in KiB on Linux
-}
-
-std::string cpu_model() {
-  std::ifstream cpuinfo("/proc/cpuinfo");
-  for (std::string line; std::getline(cpuinfo, line);) {
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  }
-  return "unknown";
-}
 
 nlohmann::json summary_of(const std::vector<double>& ms) {
   StageTimings timings;
@@ -71,7 +56,7 @@ nlohmann::json run_glint(const std::vector<io::RgbdFrame>& frames, const Intrins
   }
   nlohmann::json out{{"timings_ms", pipeline.timings().to_json()},
                      {"blocks", pipeline.volume().block_count()},
-                     {"peak_rss_mb", peak_resident_mb()}};
+                     {"peak_rss_mb", bench::peak_rss_mib()}};
   if (!params.use_ground_truth_poses) {
     const fusion::TrajectoryError ate = fusion::absolute_trajectory_error(estimated, truth);
     out["ate"] = {{"rmse_m", ate.rmse_m}, {"median_m", ate.median_m}, {"max_m", ate.max_m}};
@@ -114,7 +99,8 @@ int main(int argc, char** argv) {
       depth_paths.push_back(sequence.frames[i].depth_path);
     }
     nlohmann::json report{
-        {"machine", {{"cpu", cpu_model()}, {"threads", std::thread::hardware_concurrency()}}},
+        {"machine",
+         {{"cpu", bench::cpu_model()}, {"threads", std::thread::hardware_concurrency()}}},
         {"data", data},
         {"format", sequence.format},
         {"frames", count},
@@ -139,7 +125,7 @@ int main(int argc, char** argv) {
       open3d_params.depth_max_m = depth_max_m;
       const bench::Open3dTsdfRun open3d = bench::run_open3d_tsdf(
           colour_paths, depth_paths, poses, sequence.intrinsics, open3d_params);
-      const double open3d_peak = peak_resident_mb();
+      const double open3d_peak = bench::peak_rss_mib();
 
       std::cerr << "voxel " << voxel << " m: mesh distances\n";
       const auto glint_to_open3d = bench::surface_distance(glint_mesh, open3d.mesh, samples);
@@ -174,7 +160,7 @@ int main(int argc, char** argv) {
                                   {"open3d_to_glint", distances_json(open3d_to_glint, voxel)}}},
                                 {"glint_tracking", glint_tracked}});
     }
-    report["peak_rss_mb"] = peak_resident_mb();
+    report["peak_rss_mb"] = bench::peak_rss_mib();
     if (json_path.empty()) {
       std::cout << report.dump(2) << "\n";
     } else {

@@ -5,10 +5,8 @@
 // Writes JSON (stdout, or --json FILE).
 //
 //   render_speed [--data DIR] [--frames 30] [--threads N] [--training-sequences 40] [--json F]
-#include <sys/resource.h>
 
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -22,17 +20,11 @@
 #include "render/builtin_scenes.h"
 #include "render/renderer.h"
 #include "render/training_set.h"
+#include "support/machine.h"
 
 namespace {
 
 using namespace glint;
-
-std::string cpu_model() {
-  std::ifstream cpuinfo("/proc/cpuinfo");
-  for (std::string line; std::getline(cpuinfo, line);)
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  return "unknown";
-}
 
 // Renders `frames` poses of the trajectory (after one warm-up frame); rendering only.
 nlohmann::json scene_speed(render::Scene scene, bool shadows, int frames) {
@@ -115,7 +107,7 @@ int main(int argc, char** argv) {
   set_quiet(true);
   const auto thread_limit = limit_threads(threads);
   nlohmann::json result{
-      {"cpu", cpu_model()},
+      {"cpu", bench::cpu_model()},
       {"hardware_threads", std::thread::hardware_concurrency()},
       {"threads", threads > 0 ? threads : int(std::thread::hardware_concurrency())},
       {"data", data_dir}};
@@ -131,9 +123,7 @@ int main(int argc, char** argv) {
   if (training_sequences > 0)
     result["training_set"] = training_set_speed(data_dir, training_sequences);
 
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  result["peak_rss_mib"] = usage.ru_maxrss / 1024;
+  result["peak_rss_mib"] = bench::peak_rss_mib();
   if (json_path.empty())
     std::cout << result.dump(2) << "\n";
   else
