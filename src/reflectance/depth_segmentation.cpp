@@ -13,8 +13,6 @@ namespace {
 
 using Eigen::Vector3f;
 
-float axial_noise_m(float z) { return 0.0012f + 0.0019f * (z - 0.4f) * (z - 0.4f); }
-
 // Vertex and normal maps; a pixel without depth (or without a normal) has z = 0.
 struct Geometry {
   int width, height;
@@ -98,7 +96,7 @@ DepthSegmentation segment_depth(const ImageF& depth, const Intrinsics& intrinsic
           discontinuity |= std::abs(g.vertex[j].z() - v.z()) > p.discontinuity_ratio * v.z();
         }
       const bool edge = convexity < p.min_convexity ||
-                        distance > p.distance_k * axial_noise_m(v.z()) || discontinuity;
+                        distance > p.distance_k * kinect_axial_noise_m(v.z()) || discontinuity;
       out.edges.at(x, y, 0) = edge ? 1 : 0;
     }
   });

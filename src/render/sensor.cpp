@@ -46,7 +46,7 @@ ImageF measure_depth(const ImageF& depth_m, const CameraSettings& camera, std::u
       const float z = in[i];
       if (z <= 0) continue;
       PixelRandom random(seed, frame_index, i, RandomPurpose::depth_noise);
-      const float sigma = 0.0012f + 0.0019f * (z - 0.4f) * (z - 0.4f);
+      const float sigma = kinect_axial_noise_m(z);
       out[i] = std::max(0.0f, z + sigma * random.gaussian());
     }
   });

@@ -1,0 +1,226 @@
+#include "reflectance/observation_grid.h"
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+#include "core/error.h"
+#include "core/parallel.h"
+#include "fusion/tsdf_sampler.h"
+
+namespace glint::reflectance {
+namespace {
+
+template <class T>
+std::unique_ptr<T[], void (*)(void*)> zeroed_pool(std::size_t count) {
+  // calloc: large zeroed allocations are mapped lazily, so untouched voxels cost no memory.
+  void* memory = std::calloc(count, sizeof(T));
+  if (!memory) throw Error("observation grid", "", "cannot reserve the voxel pools");
+  return {static_cast<T*>(memory), std::free};
+}
+
+Eigen::Vector3i floor_div(const Eigen::Vector3i& v, int side) {
+  return {v.x() >= 0 ? v.x() / side : -((-v.x() + side - 1) / side),
+          v.y() >= 0 ? v.y() / side : -((-v.y() + side - 1) / side),
+          v.z() >= 0 ? v.z() / side : -((-v.z() + side - 1) / side)};
+}
+
+int block_side(const ObservationGridParams& params) {
+  if (!(params.voxel_size_m > 0) || !(params.block_size_m >= params.voxel_size_m))
+    throw Error("observation grid", "voxel_size_m",
+                "must be positive and at most the block size " +
+                    std::to_string(params.block_size_m) + " m");
+  const int side = static_cast<int>(std::lround(params.block_size_m / params.voxel_size_m));
+  if (std::fabs(side * params.voxel_size_m - params.block_size_m) > 1e-6)
+    throw Error("observation grid", "voxel_size_m",
+                "must divide the block size " + std::to_string(params.block_size_m) + " m");
+  return side;
+}
+
+}  // namespace
+
+ObservationGrid::ObservationGrid(const ObservationGridParams& params)
+    : params_(params),
+      side_(block_side(params)),
+      voxels_per_block_(side_ * side_ * side_),
+      hash_(std::max<std::size_t>(1, params.voxel_capacity / std::size_t(side_ * side_ * side_))),
+      observations_(zeroed_pool<Observation>(1)),
+      observation_count_(zeroed_pool<std::uint8_t>(1)),
+      position_(zeroed_pool<Eigen::Vector3f>(1)),
+      normal_(zeroed_pool<Eigen::Vector3f>(1)),
+      refined_kd_(zeroed_pool<Eigen::Vector3f>(1)),
+      geometry_frame_(zeroed_pool<int>(1)),
+      has_surface_(zeroed_pool<bool>(1)),
+      segment_(zeroed_pool<std::int32_t>(1)),
+      segment_confidence_(zeroed_pool<std::int16_t>(1)),
+      has_refined_kd_(zeroed_pool<bool>(1)) {
+  if (params.observations_per_voxel < 1 || params.observations_per_voxel > 255)
+    throw Error("observation grid", "observations_per_voxel", "must be in 1..255");
+  if (params.allocation_stride_px < 1)
+    throw Error("observation grid", "allocation_stride_px", "must be >= 1");
+  const std::size_t voxels = hash_.capacity() * voxels_per_block_;
+  observations_ = zeroed_pool<Observation>(voxels * params.observations_per_voxel);
+  observation_count_ = zeroed_pool<std::uint8_t>(voxels);
+  position_ = zeroed_pool<Eigen::Vector3f>(voxels);
+  normal_ = zeroed_pool<Eigen::Vector3f>(voxels);
+  refined_kd_ = zeroed_pool<Eigen::Vector3f>(voxels);
+  geometry_frame_ = zeroed_pool<int>(voxels);
+  has_surface_ = zeroed_pool<bool>(voxels);
+  segment_ = zeroed_pool<std::int32_t>(voxels);
+  segment_confidence_ = zeroed_pool<std::int16_t>(voxels);
+  has_refined_kd_ = zeroed_pool<bool>(voxels);
+  block_last_frame_ = std::make_unique<std::atomic<int>[]>(hash_.capacity());
+  for (std::size_t i = 0; i < hash_.capacity(); ++i) block_last_frame_[i] = -1;
+}
+
+int ObservationGrid::find_voxel(const Eigen::Vector3i& voxel) const {
+  const Eigen::Vector3i block = floor_div(voxel, side_);
+  const int index = hash_.find(block);
+  if (index < 0) return -1;
+  return voxel_index(index, voxel - block * side_);
+}
+
+int ObservationGrid::find(const Eigen::Vector3f& p) const {
+  const Eigen::Vector3f v = p / float(params_.voxel_size_m);
+  return find_voxel({int(std::floor(v.x())), int(std::floor(v.y())), int(std::floor(v.z()))});
+}
+
+Eigen::Vector3i ObservationGrid::voxel_coordinates(int v) const {
+  const int block = v / voxels_per_block_, local = v % voxels_per_block_;
+  return hash_.block(block) * side_ +
+         Eigen::Vector3i(local % side_, (local / side_) % side_, local / (side_ * side_));
+}
+
+void ObservationGrid::allocate(const ImageF& depth_m, const Intrinsics& intrinsics,
+                               const Pose& camera_to_world, int frame) {
+  const int stride = params_.allocation_stride_px;
+  const float inverse_block = float(1.0 / params_.block_size_m);
+  const Eigen::Matrix3f rotation = camera_to_world.linear().cast<float>();
+  const Eigen::Vector3f translation = camera_to_world.translation().cast<float>();
+  std::atomic<bool> pool_full{false};
+  const int rows = (depth_m.height() + stride - 1) / stride;
+  frame_blocks_.clear();
+  tbb::enumerable_thread_specific<std::vector<int>> local_blocks;
+  parallel_for(std::size_t(rows), [&](std::size_t row) {
+    const int y = int(row) * stride;
+    std::vector<int>& mine = local_blocks.local();
+    for (int x = 0; x < depth_m.width(); x += stride) {
+      const float z = depth_m.at(x, y, 0);
+      if (!(z > 0) || !std::isfinite(z)) continue;
+      const Eigen::Vector3f p =
+          rotation * intrinsics.back_project(x, y, z).cast<float>() + translation;
+      const Eigen::Vector3f b = p * inverse_block;
+      const Eigen::Vector3i block(int(std::floor(b.x())), int(std::floor(b.y())),
+                                  int(std::floor(b.z())));
+      const auto insertion = hash_.insert(block);
+      if (insertion.index < 0) {
+        pool_full = true;
+        return;
+      }
+      if (block_last_frame_[insertion.index].exchange(frame, std::memory_order_relaxed) != frame)
+        mine.push_back(insertion.index);
+    }
+  });
+  if (pool_full)
+    throw Error("observation grid", "voxel_capacity",
+                "pool of " + std::to_string(hash_.capacity() * voxels_per_block_) +
+                    " voxels is exhausted; raise it (--obs-voxels) or use a coarser grid");
+  for (const auto& mine : local_blocks)
+    frame_blocks_.insert(frame_blocks_.end(), mine.begin(), mine.end());
+}
+
+void ObservationGrid::refresh_surface(int v, const Eigen::Vector3f& centre,
+                                      const fusion::TsdfVolume& geometry) {
+  // Two Newton steps onto the zero level set along the (central-difference) SDF gradient.
+  fusion::TsdfSampler sampler(geometry);
+  const float h = float(geometry.params().voxel_size_m);
+  Eigen::Vector3f p = centre, gradient = Eigen::Vector3f::Zero();
+  bool found = false;
+  for (int step = 0; step < 2; ++step) {
+    float sdf = 0, plus = 0, minus = 0;
+    if (!sampler.trilinear(p, sdf)) break;
+    bool ok = true;
+    for (int axis = 0; axis < 3 && ok; ++axis) {
+      Eigen::Vector3f offset = Eigen::Vector3f::Zero();
+      offset[axis] = h;
+      ok = sampler.trilinear(p + offset, plus) && sampler.trilinear(p - offset, minus);
+      gradient[axis] = (plus - minus) / (2 * h);
+    }
+    const float norm = gradient.norm();
+    if (!ok || !(norm > 0.1f)) break;
+    p -= sdf / (norm * norm) * gradient;
+    found = true;
+  }
+  // The surface must pass through this voxel (its neighbours own the rest of the patch).
+  const float half = 0.5f * float(params_.voxel_size_m);
+  found = found && ((p - centre).cwiseAbs().maxCoeff() <= half * 1.001f);
+  has_surface_[v] = found;
+  if (!found) return;
+  position_[v] = p;
+  normal_[v] = gradient.normalized();
+}
+
+const std::vector<VisibleVoxel>& ObservationGrid::collect(
+    const ImageF& depth_m, const ImageF& colour, const Intrinsics& intrinsics,
+    const Pose& camera_to_world, float exposure, const fusion::TsdfVolume& geometry, int frame) {
+  if (depth_m.channels() != 1 || depth_m.width() != intrinsics.width ||
+      depth_m.height() != intrinsics.height || colour.channels() != 3 || !colour.same_size(depth_m))
+    throw Error("observation grid", "frame " + std::to_string(frame),
+                "needs a 1-channel depth and a 3-channel colour image of the intrinsics' size");
+  if (!(exposure > 0)) throw Error("observation grid", "exposure", "must be positive");
+  allocate(depth_m, intrinsics, camera_to_world, frame);
+
+  const Pose world_to_camera = camera_to_world.inverse();
+  const Eigen::Matrix3f rotation = world_to_camera.linear().cast<float>();
+  const Eigen::Vector3f translation = world_to_camera.translation().cast<float>();
+  const Eigen::Vector3f camera_centre = camera_to_world.translation().cast<float>();
+  const float inverse_exposure = 1.0f / exposure;
+  const int capacity = params_.observations_per_voxel;
+  const int width = depth_m.width(), height = depth_m.height();
+
+  // One slot per voxel of the frame's blocks; -1 = not observed.
+  visible_.assign(frame_blocks_.size() * voxels_per_block_, VisibleVoxel{-1, -1});
+  parallel_for(frame_blocks_.size(), [&](std::size_t slot) {
+    const int block = frame_blocks_[slot];
+    const Eigen::Vector3i first_voxel = hash_.block(block) * side_;
+    for (int local = 0; local < voxels_per_block_; ++local) {
+      const Eigen::Vector3i offset(local % side_, (local / side_) % side_, local / (side_ * side_));
+      const int v = block * voxels_per_block_ + local;
+      if (geometry_frame_[v] == 0 ||
+          frame + 1 - geometry_frame_[v] >= params_.geometry_refresh_frames) {
+        refresh_surface(v, voxel_centre(first_voxel + offset), geometry);
+        geometry_frame_[v] = frame + 1;
+      }
+      if (!has_surface_[v]) continue;
+      // Visibility: in the image, in front, facing the camera, not occluded.
+      const Eigen::Vector3f q = rotation * position_[v] + translation;
+      if (!(q.z() > 0)) continue;
+      const float u = float(intrinsics.fx) * q.x() / q.z() + float(intrinsics.cx);
+      const float w = float(intrinsics.fy) * q.y() / q.z() + float(intrinsics.cy);
+      const int x = int(std::lround(u)), y = int(std::lround(w));
+      if (x < 0 || y < 0 || x >= width || y >= height) continue;
+      const float measured = depth_m.at(x, y, 0);
+      const float tolerance = float(params_.depth_tolerance_m) +
+                              float(params_.depth_tolerance_sigmas) * kinect_axial_noise_m(q.z());
+      if (!(measured > 0) || std::fabs(measured - q.z()) > tolerance) continue;
+      const Eigen::Vector3f direction = (camera_centre - position_[v]).normalized();
+      if (normal_[v].dot(direction) < float(params_.min_view_cosine)) continue;
+      Observation observation;
+      observation.colour =
+          Eigen::Vector3f(colour.at(x, y, 0), colour.at(x, y, 1), colour.at(x, y, 2)) *
+          inverse_exposure;
+      observation.direction = direction;
+      observation.frame = std::uint32_t(frame);
+      Observation* slots = observations_.get() + std::size_t(v) * capacity;
+      observation_count_[v] =
+          std::uint8_t(insert_observation(slots, observation_count_[v], capacity, observation));
+      visible_[slot * voxels_per_block_ + local] = {v, y * width + x};
+    }
+  });
+  std::erase_if(visible_, [](const VisibleVoxel& seen) { return seen.voxel < 0; });
+  return visible_;
+}
+
+}  // namespace glint::reflectance

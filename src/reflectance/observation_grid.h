@@ -1,0 +1,133 @@
+#pragma once
+// ObservationGrid: the coarse voxel hash that collects reflectance observations (paper 1 §3.4).
+// It is separate from the geometry's TSDF: its voxels are 2 cm or 1 cm (the TSDF's 5 mm), so a
+// block of the TSDF's spatial extent holds 2^3 or 4^3 of them, and it has its own fixed pools.
+//
+// Per voxel it keeps:
+//  - a surface point and normal, taken from the fused TSDF: the voxel centre moved onto the zero
+//    level set along the SDF gradient (two Newton steps), refreshed every few frames while the
+//    geometry converges; voxels the surface does not pass through have none;
+//  - at most `observations_per_voxel` (m = 30) observations: linear radiance (pixel / exposure)
+//    and the unit voxel-to-camera direction, with the most-similar-pair replacement of
+//    reflectance/observation.h;
+//  - its segment id and a confidence (reflectance/segment_map.h) and its refined diffuse albedo
+//    (reflectance/albedo_refinement.h).
+//
+// collect() runs once per frame: every allocation_stride_px-th depth pixel allocates the voxel
+// it back-projects into; each voxel of the frame's blocks is then projected into the depth
+// image and observed when it is in front of the camera, faces it, and its depth agrees with the
+// measured one (the visibility / occlusion test). Pools are allocated once; their memory is
+// committed as voxels are used.
+#include <Eigen/Core>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/image.h"
+#include "fusion/tsdf_volume.h"
+#include "fusion/voxel_block_hash.h"
+#include "reflectance/observation.h"
+
+namespace glint::reflectance {
+
+struct ObservationGridParams {
+  double voxel_size_m = 0.02;  // paper 1 §4.1: 2 cm (low) or 1 cm (high resolution)
+  // A block spans the geometry block's extent (8 TSDF voxels): (block_size_m / voxel_size_m)^3
+  // voxels, 2^3 or 4^3 with the defaults.
+  double block_size_m = 0.04;
+  int observations_per_voxel = 30;        // m
+  std::size_t voxel_capacity = 1u << 20;  // pool size; exhaustion is a glint::Error
+  int allocation_stride_px = 2;           // every n-th pixel of every n-th row allocates
+  double depth_tolerance_m = 0.01;        // |measured - voxel depth| allowed, plus ...
+  double depth_tolerance_sigmas = 3;      // ... this many Kinect sigma(z) (render/sensor.h)
+  double min_view_cosine = 0.1;           // normal . direction of an accepted observation
+  int geometry_refresh_frames = 8;        // surface point / normal recomputed this often
+};
+
+// One voxel seen in the current frame: its pool index and the pixel it projects to.
+struct VisibleVoxel {
+  int voxel = 0;
+  int pixel = 0;  // y * width + x
+};
+
+class ObservationGrid {
+ public:
+  explicit ObservationGrid(const ObservationGridParams& params = {});
+
+  const ObservationGridParams& params() const { return params_; }
+  int voxels_per_block_side() const { return side_; }
+  std::size_t voxel_count() const { return hash_.size() * voxels_per_block_; }
+  std::size_t block_count() const { return hash_.size(); }
+
+  // One frame: depth in metres (0 = none), linear RGB colour of the same size, the frame's pose,
+  // `exposure` (radiance = colour / exposure) and the fused geometry. Returns the voxels observed
+  // in this frame (each once). Throws glint::Error when the pool is exhausted or sizes differ.
+  const std::vector<VisibleVoxel>& collect(const ImageF& depth_m, const ImageF& colour,
+                                           const Intrinsics& intrinsics,
+                                           const Pose& camera_to_world, float exposure,
+                                           const fusion::TsdfVolume& geometry, int frame);
+
+  // The latest collect()'s result.
+  const std::vector<VisibleVoxel>& visible() const { return visible_; }
+
+  // Per-voxel data, by pool index (< voxel_count()).
+  bool has_surface(int v) const { return has_surface_[v]; }
+  const Eigen::Vector3f& position(int v) const { return position_[v]; }
+  const Eigen::Vector3f& normal(int v) const { return normal_[v]; }
+  int observation_count(int v) const { return observation_count_[v]; }
+  const Observation* observations(int v) const {
+    return observations_.get() + std::size_t(v) * params_.observations_per_voxel;
+  }
+  std::int32_t& segment(int v) { return segment_[v]; }
+  std::int32_t segment(int v) const { return segment_[v]; }
+  std::int16_t& segment_confidence(int v) { return segment_confidence_[v]; }
+  Eigen::Vector3f& refined_kd(int v) { return refined_kd_[v]; }
+  const Eigen::Vector3f& refined_kd(int v) const { return refined_kd_[v]; }
+  bool& has_refined_kd(int v) { return has_refined_kd_[v]; }
+  bool has_refined_kd(int v) const { return has_refined_kd_[v]; }
+
+  // Pool index of the voxel containing world point p, or -1.
+  int find(const Eigen::Vector3f& p) const;
+  // Pool index of the voxel at integer grid coordinates, or -1.
+  int find_voxel(const Eigen::Vector3i& voxel) const;
+  // Integer grid coordinates of pool index v.
+  Eigen::Vector3i voxel_coordinates(int v) const;
+  // World centre of the voxel at integer grid coordinates.
+  Eigen::Vector3f voxel_centre(const Eigen::Vector3i& voxel) const {
+    return (voxel.cast<float>() + Eigen::Vector3f::Constant(0.5f)) * float(params_.voxel_size_m);
+  }
+
+ private:
+  template <class T>
+  using Pool = std::unique_ptr<T[], void (*)(void*)>;
+
+  int voxel_index(int block, const Eigen::Vector3i& local) const {
+    return block * voxels_per_block_ + (local.z() * side_ + local.y()) * side_ + local.x();
+  }
+  void allocate(const ImageF& depth_m, const Intrinsics& intrinsics, const Pose& camera_to_world,
+                int frame);
+  void refresh_surface(int v, const Eigen::Vector3f& centre, const fusion::TsdfVolume& geometry);
+
+  ObservationGridParams params_;
+  int side_ = 2;
+  int voxels_per_block_ = 8;
+  fusion::VoxelBlockHash hash_;
+  std::unique_ptr<std::atomic<int>[]> block_last_frame_;
+  std::vector<int> frame_blocks_;
+
+  // Structure-of-arrays voxel pools (zero-initialised, committed on first touch).
+  Pool<Observation> observations_;
+  Pool<std::uint8_t> observation_count_;
+  Pool<Eigen::Vector3f> position_, normal_, refined_kd_;
+  Pool<int> geometry_frame_;  // frame of the last surface refresh + 1 (0 = never tried)
+  Pool<bool> has_surface_;
+  Pool<std::int32_t> segment_;
+  Pool<std::int16_t> segment_confidence_;
+  Pool<bool> has_refined_kd_;
+
+  std::vector<VisibleVoxel> visible_;
+};
+
+}  // namespace glint::reflectance

@@ -1,0 +1,92 @@
+#include "reflectance/segment_map.h"
+
+#include <algorithm>
+#include <map>
+
+namespace glint::reflectance {
+
+SegmentMap::Ring& SegmentMap::ring(int segment) {
+  if (segment >= int(segments_.size())) segments_.resize(segment + 1);
+  return segments_[segment];
+}
+
+int SegmentMap::ring_size(int segment) const {
+  return segment > 0 && segment < int(segments_.size()) ? int(segments_[segment].voxels.size()) : 0;
+}
+
+void SegmentMap::assign(ObservationGrid& grid, int voxel, int segment) {
+  std::int32_t& current = grid.segment(voxel);
+  std::int16_t& confidence = grid.segment_confidence(voxel);
+  if (current == segment) {
+    confidence = std::int16_t(std::min<int>(confidence + 1, params_.max_confidence));
+    return;
+  }
+  if (current != 0 && --confidence > 0) return;
+  current = segment;
+  confidence = 1;
+  Ring& members = ring(segment);
+  if (int(members.voxels.size()) < params_.ring_capacity) {
+    members.voxels.push_back(voxel);
+  } else {
+    members.voxels[members.next] = voxel;
+    members.next = (members.next + 1) % members.voxels.size();
+  }
+}
+
+void SegmentMap::update(ObservationGrid& grid, const std::vector<VisibleVoxel>& visible,
+                        const Image<std::int32_t>& frame_labels, bool labels_are_global) {
+  const std::int32_t* labels = frame_labels.plane(0);
+  std::map<int, int> global_of_label;
+  if (labels_are_global) {
+    for (const VisibleVoxel& seen : visible)
+      if (labels[seen.pixel] > 0) global_of_label[labels[seen.pixel]] = labels[seen.pixel];
+  } else {
+    // Overlap of every frame label with the global ids its voxels carry (0 = none yet).
+    std::map<int, std::map<int, int>> overlap;
+    for (const VisibleVoxel& seen : visible)
+      if (labels[seen.pixel] > 0) ++overlap[labels[seen.pixel]][grid.segment(seen.voxel)];
+    for (const auto& [label, counts] : overlap) {
+      int total = 0, best_id = 0, best_count = 0;
+      for (const auto& [id, count] : counts) {
+        total += count;
+        if (id > 0 && count > best_count) best_id = id, best_count = count;
+      }
+      if (best_id > 0 && best_count >= params_.min_overlap * total)
+        global_of_label[label] = best_id;
+      else if (total >= params_.min_new_segment_voxels) {
+        global_of_label[label] = int(segments_.size());  // a new segment
+        segments_.emplace_back();
+      }
+    }
+  }
+  frame_segments_.clear();
+  for (const VisibleVoxel& seen : visible) {
+    const int label = labels[seen.pixel];
+    if (label <= 0) continue;
+    const auto found = global_of_label.find(label);
+    if (found != global_of_label.end()) assign(grid, seen.voxel, found->second);
+  }
+  for (const auto& [label, id] : global_of_label) frame_segments_.push_back(id);
+  std::sort(frame_segments_.begin(), frame_segments_.end());
+  frame_segments_.erase(std::unique(frame_segments_.begin(), frame_segments_.end()),
+                        frame_segments_.end());
+}
+
+int SegmentMap::sample(const ObservationGrid& grid, int segment, int count, int min_observations,
+                       std::mt19937_64& random, int* voxels) const {
+  if (segment <= 0 || segment >= int(segments_.size())) return 0;
+  const std::vector<int>& members = segments_[segment].voxels;
+  if (members.empty()) return 0;
+  std::uniform_int_distribution<std::size_t> pick(0, members.size() - 1);
+  int found = 0;
+  for (int attempt = 0; attempt < 8 * count && found < count; ++attempt) {
+    const int v = members[pick(random)];
+    if (grid.segment(v) != segment || grid.observation_count(v) < min_observations ||
+        std::find(voxels, voxels + found, v) != voxels + found)
+      continue;
+    voxels[found++] = v;
+  }
+  return found;
+}
+
+}  // namespace glint::reflectance

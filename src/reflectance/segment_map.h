@@ -1,0 +1,65 @@
+#pragma once
+// Globally consistent segments over time (paper 1 §3.5; Tateno et al. 2016 §4): each frame's
+// depth segmentation (reflectance/depth_segmentation.h) labels the observation voxels it sees,
+// and those per-frame labels are propagated into global segment ids.
+//  - A frame segment takes the global id that most of its already-labelled voxels carry, when
+//    they are at least min_overlap of its voxels; otherwise, if it has min_new_segment_voxels
+//    voxels, it starts a new global segment.
+//  - A voxel's id changes only after repeated disagreement: agreeing frames raise its
+//    confidence (up to max_confidence), disagreeing ones lower it, and at 0 it switches.
+// Each global segment owns a fixed-size ring buffer of voxel references that new members are
+// written into (the oldest entry is overwritten); the specular estimation samples voxels of a
+// segment from it. Entries may be stale (the voxel changed segment): samplers check.
+// In ground-truth mode the frame labels are already global ids (the synthetic gt/segment
+// images) and are written to the voxels directly.
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "core/image.h"
+#include "reflectance/observation_grid.h"
+
+namespace glint::reflectance {
+
+struct SegmentMapParams {
+  int ring_capacity = 4096;  // voxel references per segment
+  double min_overlap = 0.3;
+  int min_new_segment_voxels = 20;
+  int max_confidence = 8;
+};
+
+class SegmentMap {
+ public:
+  explicit SegmentMap(const SegmentMapParams& params = {}) : params_(params) {}
+
+  // Labels the voxels observed in this frame. frame_labels: one value per pixel (0 = none);
+  // labels_are_global: ground-truth ids instead of per-frame labels.
+  void update(ObservationGrid& grid, const std::vector<VisibleVoxel>& visible,
+              const Image<std::int32_t>& frame_labels, bool labels_are_global);
+
+  // Global ids (> 0) that voxels of the latest frame carry, ascending.
+  const std::vector<int>& frame_segments() const { return frame_segments_; }
+  // Largest global id handed out so far.
+  int max_segment_id() const { return int(segments_.size()) - 1; }
+  // Voxel references currently in the segment's ring (stale ones included).
+  int ring_size(int segment) const;
+
+  // Writes up to `count` distinct voxels of `segment` that still carry its id and have at
+  // least `min_observations` observations, drawn at random from its ring; returns how many.
+  int sample(const ObservationGrid& grid, int segment, int count, int min_observations,
+             std::mt19937_64& random, int* voxels) const;
+
+ private:
+  struct Ring {
+    std::vector<int> voxels;
+    std::size_t next = 0;
+  };
+  Ring& ring(int segment);
+  void assign(ObservationGrid& grid, int voxel, int segment);
+
+  SegmentMapParams params_;
+  std::vector<Ring> segments_{1};  // index = global id; 0 unused
+  std::vector<int> frame_segments_;
+};
+
+}  // namespace glint::reflectance

@@ -1,0 +1,123 @@
+// Segment propagation on a two-object scene: two walls at different depths, seen by a camera
+// that slides between frames, with per-frame labels whose numbering changes from frame to frame.
+#include "reflectance/segment_map.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <random>
+#include <set>
+
+#include "fusion/integrate.h"
+#include "reflectance/depth_segmentation.h"
+
+namespace glint::reflectance {
+namespace {
+
+const Intrinsics kCamera{96, 72, 70.0, 70.0, 47.5, 35.5};
+
+// Left of world x = 0 a wall at z = 1.0 m, right of it a wall at z = 1.4 m (two objects).
+ImageF two_walls_depth(double camera_x) {
+  ImageF depth(kCamera.width, kCamera.height, 1);
+  for (int y = 0; y < kCamera.height; ++y)
+    for (int x = 0; x < kCamera.width; ++x) {
+      const Eigen::Vector3d ray = kCamera.ray(x, y);
+      const double left_z = 1.0, right_z = 1.4;
+      depth.at(x, y, 0) = float(camera_x + ray.x() * left_z < 0 ? left_z : right_z);
+    }
+  return depth;
+}
+
+// Which wall a world point belongs to.
+int wall_of(const Eigen::Vector3f& p) { return p.z() < 1.2f ? 1 : 2; }
+
+struct Scene {
+  fusion::TsdfVolume geometry{[] {
+    fusion::VolumeParams params;
+    params.voxel_size_m = 0.005;
+    params.block_capacity = 1 << 13;
+    return params;
+  }()};
+  ObservationGrid grid{ObservationGridParams{.voxel_capacity = 1 << 15}};
+  fusion::VisibleBlocks blocks;
+  ImageF colour{kCamera.width, kCamera.height, 3, 0.3f};
+
+  const std::vector<VisibleVoxel>& frame(int index, double camera_x, ImageF& depth) {
+    depth = two_walls_depth(camera_x);
+    Pose pose = Pose::Identity();
+    pose.translation().x() = camera_x;
+    fusion::integrate(geometry, depth, colour, kCamera, pose, blocks);
+    return grid.collect(depth, colour, kCamera, pose, 1.0f, geometry, index);
+  }
+};
+
+TEST(SegmentMap, PropagatesTwoObjectsAcrossRenumberedFrames) {
+  Scene scene;
+  SegmentMap segments;
+  for (int index = 0; index < 6; ++index) {
+    ImageF depth;
+    const double camera_x = -0.05 + 0.02 * index;
+    const auto& visible = scene.frame(index, camera_x, depth);
+    // Per-frame labels from the depth image, renumbered every other frame (as a per-frame
+    // segmentation would number them arbitrarily).
+    Image<std::int32_t> labels(kCamera.width, kCamera.height, 1);
+    for (int y = 0; y < kCamera.height; ++y)
+      for (int x = 0; x < kCamera.width; ++x) {
+        const int wall = depth.at(x, y, 0) < 1.2f ? 1 : 2;
+        labels.at(x, y, 0) = index % 2 ? 3 - wall : wall + 4;
+      }
+    segments.update(scene.grid, visible, labels, false);
+    EXPECT_EQ(segments.frame_segments().size(), 2u) << "frame " << index;
+  }
+  EXPECT_EQ(segments.max_segment_id(), 2) << "no segment beyond the two objects";
+  // Every labelled voxel carries the id of its wall's segment, one id per wall.
+  std::map<int, std::set<int>> ids_of_wall;
+  for (int v = 0; v < int(scene.grid.voxel_count()); ++v)
+    if (scene.grid.segment(v) > 0)
+      ids_of_wall[wall_of(scene.grid.position(v))].insert(scene.grid.segment(v));
+  ASSERT_EQ(ids_of_wall.size(), 2u);
+  EXPECT_EQ(ids_of_wall[1].size(), 1u);
+  EXPECT_EQ(ids_of_wall[2].size(), 1u);
+  EXPECT_NE(*ids_of_wall[1].begin(), *ids_of_wall[2].begin());
+
+  // Sampling returns distinct voxels of the asked segment only.
+  std::mt19937_64 random(3);
+  const int id = *ids_of_wall[1].begin();
+  std::vector<int> sampled(25);
+  const int count = segments.sample(scene.grid, id, 25, 1, random, sampled.data());
+  EXPECT_EQ(count, 25);
+  std::set<int> distinct(sampled.begin(), sampled.begin() + count);
+  EXPECT_EQ(distinct.size(), std::size_t(count));
+  for (int v : distinct) EXPECT_EQ(scene.grid.segment(v), id);
+}
+
+TEST(SegmentMap, DepthSegmentationSeparatesTheWallsAndStaysConsistent) {
+  Scene scene;
+  SegmentMap segments;
+  DepthSegmentationParams params;
+  params.min_segment_px = 50;
+  for (int index = 0; index < 4; ++index) {
+    ImageF depth;
+    const auto& visible = scene.frame(index, -0.04 + 0.02 * index, depth);
+    segments.update(scene.grid, visible, segment_depth(depth, kCamera, params).labels, false);
+  }
+  EXPECT_EQ(segments.max_segment_id(), 2);
+}
+
+TEST(SegmentMap, GroundTruthIdsAreUsedAsTheyAre) {
+  Scene scene;
+  SegmentMap segments;
+  ImageF depth;
+  const auto& visible = scene.frame(0, 0.0, depth);
+  Image<std::int32_t> ids(kCamera.width, kCamera.height, 1);
+  for (int y = 0; y < kCamera.height; ++y)
+    for (int x = 0; x < kCamera.width; ++x) ids.at(x, y, 0) = depth.at(x, y, 0) < 1.2f ? 7 : 9;
+  segments.update(scene.grid, visible, ids, true);
+  EXPECT_EQ(segments.frame_segments(), (std::vector<int>{7, 9}));
+  for (const VisibleVoxel& seen : visible)
+    EXPECT_EQ(scene.grid.segment(seen.voxel),
+              wall_of(scene.grid.position(seen.voxel)) == 1 ? 7 : 9);
+}
+
+}  // namespace
+}  // namespace glint::reflectance
