@@ -12,8 +12,10 @@
 namespace glint::reflectance {
 
 struct LightCaptureParams {
-  float min_luminance = 0.9f;  // linear luminance of a pixel in [0, 1] (Rec. 709 weights)
-  float exposure = 1.0f;       // the capture's exposure: sample radiance = pixel / exposure
+  // Linear luminance (Rec. 709 weights) of a pixel in [0, 1]; the built-in captures
+  // (render::kLightCaptureExposure) read >= 0.29 on light proxies, < 0.02 on lit surfaces.
+  float min_luminance = 0.05f;
+  float exposure = 1.0f;  // the capture's exposure: sample radiance = pixel / exposure
   MeanShiftParams clustering;
   double min_cluster_px = 10;  // smaller clusters are noise or glints
 };

@@ -13,7 +13,7 @@ TEST(LightCapture, BackProjectsABrightDiscToItsWorldPosition) {
   Pose camera = Pose::Identity();
   camera.linear() << 1, 0, 0, 0, 0, 1, 0, -1, 0;  // camera z -> world +y, camera y -> world -z
   camera.translation() = Eigen::Vector3d(0.5, 0.0, -0.25);
-  ImageF rgb(64, 48, 3, 0.05f), depth(64, 48, 1, 3.0f);
+  ImageF rgb(64, 48, 3, 0.01f), depth(64, 48, 1, 3.0f);  // dark background
   for (int y = 20; y < 27; ++y)
     for (int x = 10; x < 17; ++x) {  // 7x7 bright pixels centred on (13, 23)
       for (int c = 0; c < 3; ++c) rgb.at(x, y, c) = 1.0f;
