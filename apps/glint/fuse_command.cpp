@@ -16,6 +16,7 @@
 #include "io/ply.h"
 #include "io/rgbd_sequence.h"
 #include "io/trajectory.h"
+#include "volume_options.h"
 
 namespace glint::app {
 namespace {
@@ -136,19 +137,7 @@ void run_fuse(const FuseOptions& options) {
 
 }  // namespace
 
-void register_fuse_command(CLI::App& app) {
-  auto options = std::make_shared<FuseOptions>();
-  fusion::VolumeParams& volume = options->params.volume;
-  CLI::App* command = app.add_subcommand(
-      "fuse",
-      "Reconstruct a surface from an RGB-D sequence: voxel-hashed TSDF fusion (8^3-voxel blocks,\n"
-      "VoxelHashing), camera tracking by coarse-to-fine point-to-plane ICP against the ray-cast\n"
-      "model (or the dataset's ground-truth poses), marching-cubes mesh with colours.\n"
-      "Layouts, detected from the folder: glint synthetic (intrinsics.json + associations.txt),\n"
-      "TUM RGB-D, 7-Scenes/tsdf-fusion (frame-*.depth.png) and Redwood/Open3D (color/, depth/).");
-  command->add_option("dataset", options->dataset, "RGB-D sequence folder")->required();
-  command->add_option("-o,--output", options->mesh, "Mesh (PLY, binary, sRGB vertex colours)")
-      ->required();
+void add_volume_options(CLI::App* command, fusion::VolumeParams& volume) {
   command->add_option("--voxel", volume.voxel_size_m, "Voxel size, metres")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
@@ -167,6 +156,21 @@ void register_fuse_command(CLI::App& app) {
   command->add_option("--blocks", volume.block_capacity, "Block pool capacity (10 KiB per block)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+}
+
+void register_fuse_command(CLI::App& app) {
+  auto options = std::make_shared<FuseOptions>();
+  CLI::App* command = app.add_subcommand(
+      "fuse",
+      "Reconstruct a surface from an RGB-D sequence: voxel-hashed TSDF fusion (8^3-voxel blocks,\n"
+      "VoxelHashing), camera tracking by coarse-to-fine point-to-plane ICP against the ray-cast\n"
+      "model (or the dataset's ground-truth poses), marching-cubes mesh with colours.\n"
+      "Layouts, detected from the folder: glint synthetic (intrinsics.json + associations.txt),\n"
+      "TUM RGB-D, 7-Scenes/tsdf-fusion (frame-*.depth.png) and Redwood/Open3D (color/, depth/).");
+  command->add_option("dataset", options->dataset, "RGB-D sequence folder")->required();
+  command->add_option("-o,--output", options->mesh, "Mesh (PLY, binary, sRGB vertex colours)")
+      ->required();
+  add_volume_options(command, options->params.volume);
   command->add_flag("--gt-poses", options->params.use_ground_truth_poses,
                     "Use the dataset's ground-truth poses instead of tracking");
   command->add_option("--frames", options->frames, "Use the first N frames (0 = all)")

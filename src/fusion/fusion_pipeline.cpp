@@ -37,7 +37,8 @@ FrameResult FusionPipeline::process(const io::RgbdFrame& frame) {
     Stopwatch watch;
     allocate_blocks(volume_, frame.depth_m, intrinsics_, result.camera_to_world, visible_);
     const double allocate_ms = watch.elapsed_ms();
-    integrate_blocks(volume_, visible_, frame.depth_m, frame.colour, intrinsics_,
+    integrate_blocks(volume_, visible_, frame.depth_m,
+                     params_.integrate_colour ? frame.colour : ImageF(), intrinsics_,
                      result.camera_to_world);
     timings_.add("integrate", watch.elapsed_ms());
     timings_.add("allocate_blocks", allocate_ms);

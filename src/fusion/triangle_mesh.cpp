@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstring>
 
+#include "core/error.h"
 #include "io/atomic_file.h"
 
 namespace glint::fusion {
@@ -45,10 +46,18 @@ void write_mesh_ply(const std::string& path, const TriangleMesh& mesh) {
       << "element vertex " << mesh.vertices.size() << "\n"
       << "property float x\nproperty float y\nproperty float z\n";
   if (with_colour) out << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  for (const auto& [name, values] : mesh.vertex_properties) {
+    if (values.size() != mesh.vertices.size())
+      throw Error(path, name,
+                  "has " + std::to_string(values.size()) + " values for " +
+                      std::to_string(mesh.vertices.size()) + " vertices");
+    out << "property float " << name << "\n";
+  }
   out << "element face " << mesh.triangles.size() << "\n"
       << "property list uchar int vertex_indices\nend_header\n";
   std::vector<char> buffer;
-  const std::size_t vertex_bytes = 12 + (with_colour ? 3 : 0);
+  const std::size_t colour_bytes = with_colour ? 3 : 0;
+  const std::size_t vertex_bytes = 12 + colour_bytes + 4 * mesh.vertex_properties.size();
   buffer.resize(mesh.vertices.size() * vertex_bytes);
   for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
     char* record = buffer.data() + i * vertex_bytes;
@@ -57,6 +66,8 @@ void write_mesh_ply(const std::string& path, const TriangleMesh& mesh) {
       for (int c = 0; c < 3; ++c)
         record[12 + c] = static_cast<char>(linear_to_srgb8(mesh.colours[i][c]));
     }
+    for (std::size_t k = 0; k < mesh.vertex_properties.size(); ++k)
+      std::memcpy(record + 12 + colour_bytes + 4 * k, &mesh.vertex_properties[k].second[i], 4);
   }
   out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
   buffer.resize(mesh.triangles.size() * 13);

@@ -3,6 +3,7 @@
 // PLY output and the measures the tests and reports use.
 #include <Eigen/Core>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace glint::fusion {
@@ -11,6 +12,8 @@ struct TriangleMesh {
   std::vector<Eigen::Vector3f> vertices;   // metres
   std::vector<Eigen::Vector3f> colours;    // linear RGB in [0,1], one per vertex (or empty)
   std::vector<Eigen::Vector3i> triangles;  // counter-clockwise seen from outside
+  // Extra per-vertex float properties (PLY name, one value per vertex), e.g. material maps.
+  std::vector<std::pair<std::string, std::vector<float>>> vertex_properties;
 };
 
 // Total triangle area, square metres.
@@ -19,7 +22,8 @@ double surface_area(const TriangleMesh& mesh);
 // positive when the triangles face outwards).
 double enclosed_volume(const TriangleMesh& mesh);
 
-// Binary little-endian PLY: float x, y, z, uchar red, green, blue (8-bit sRGB) per vertex,
+// Binary little-endian PLY: float x, y, z, uchar red, green, blue (8-bit sRGB), then the
+// vertex_properties as floats, per vertex;
 // "list uchar int vertex_indices" per face. Written atomically; throws glint::Error naming
 // the path.
 void write_mesh_ply(const std::string& path, const TriangleMesh& mesh);

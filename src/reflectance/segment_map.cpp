@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <numeric>
 
 namespace glint::reflectance {
 
@@ -77,10 +78,16 @@ int SegmentMap::sample(const ObservationGrid& grid, int segment, int count, int 
   if (segment <= 0 || segment >= int(segments_.size())) return 0;
   const std::vector<int>& members = segments_[segment].voxels;
   if (members.empty()) return 0;
-  std::uniform_int_distribution<std::size_t> pick(0, members.size() - 1);
+  // One pass over the ring in a random order (a random start and a step coprime to its size):
+  // every member is looked at once, so rarely observed voxels cannot starve the sample.
+  const std::size_t n = members.size();
+  std::uniform_int_distribution<std::size_t> pick(0, n - 1);
+  const std::size_t start = pick(random);
+  std::size_t step = n > 1 ? 1 + pick(random) % (n - 1) : 1;
+  while (std::gcd(step, n) != 1) ++step;
   int found = 0;
-  for (int attempt = 0; attempt < 8 * count && found < count; ++attempt) {
-    const int v = members[pick(random)];
+  for (std::size_t k = 0; k < n && found < count; ++k) {
+    const int v = members[(start + k * step) % n];
     if (grid.segment(v) != segment || grid.observation_count(v) < min_observations ||
         std::find(voxels, voxels + found, v) != voxels + found)
       continue;

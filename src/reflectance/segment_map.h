@@ -45,7 +45,8 @@ class SegmentMap {
   int ring_size(int segment) const;
 
   // Writes up to `count` distinct voxels of `segment` that still carry its id and have at
-  // least `min_observations` observations, drawn at random from its ring; returns how many.
+  // least `min_observations` observations, drawn at random from its ring (each member is
+  // considered at most once, so at most ring_capacity checks); returns how many.
   int sample(const ObservationGrid& grid, int segment, int count, int min_observations,
              std::mt19937_64& random, int* voxels) const;
 

@@ -1,0 +1,242 @@
+#include "reflectance/material_evaluation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "core/error.h"
+#include "denoise/metrics.h"
+#include "io/image_io.h"
+#include "render/sensor.h"
+
+namespace glint::reflectance {
+namespace {
+
+namespace fs = std::filesystem;
+
+// gt/<kind>/<frame name>.<extension> beside the frame's rgb/<frame name>.png.
+std::string ground_truth_path(const io::RgbdSequence& sequence, std::size_t i,
+                              const std::string& kind, const std::string& extension) {
+  const fs::path colour = sequence.frames.at(i).colour_path;
+  return (fs::path(sequence.folder) / "gt" / kind / colour.stem()).string() + extension;
+}
+
+ImageF read_checked(const std::string& path, int channels) {
+  ImageF image = io::read_image(path);
+  if (image.channels() != channels)
+    throw Error(path, "",
+                "expected " + std::to_string(channels) + " channels, found " +
+                    std::to_string(image.channels()));
+  return image;
+}
+
+ImageF srgb_encoded(const ImageF& linear) {
+  ImageF encoded = linear;
+  for (float& value : encoded.values()) value = render::linear_to_srgb(std::clamp(value, 0.f, 1.f));
+  return encoded;
+}
+
+struct Box {
+  int x0, y0, x1, y1;  // inclusive-exclusive
+};
+
+ImageF crop(const ImageF& image, const Box& box) {
+  ImageF out(box.x1 - box.x0, box.y1 - box.y0, image.channels());
+  for (int c = 0; c < image.channels(); ++c)
+    for (int y = box.y0; y < box.y1; ++y)
+      for (int x = box.x0; x < box.x1; ++x) out.at(x - box.x0, y - box.y0, c) = image.at(x, y, c);
+  return out;
+}
+
+Scores score(const ImageF& truth, const ImageF& estimate, const ImageF& mask, const Box& box) {
+  double absolute = 0, squared = 0;
+  std::size_t count = 0;
+  for (int y = box.y0; y < box.y1; ++y)
+    for (int x = box.x0; x < box.x1; ++x) {
+      if (mask.at(x, y, 0) < 0.5f) continue;
+      for (int c = 0; c < truth.channels(); ++c) {
+        const double d = double(estimate.at(x, y, c)) - truth.at(x, y, c);
+        absolute += std::fabs(d);
+        squared += d * d;
+        ++count;
+      }
+    }
+  Scores s;
+  s.l1 = absolute / count;
+  const double mse = squared / count;
+  s.rmse = std::sqrt(mse);
+  s.psnr = -10.0 * std::log10(std::max(mse, 1e-10));  // capped at 100 dB
+  // SSIM over the object's bounding box (the masked mean is the same; it is far cheaper).
+  const ImageF box_mask = crop(mask, box);
+  s.ssim = denoise::ssim(crop(truth, box), crop(estimate, box), &box_mask);
+  return s;
+}
+
+double masked_mean(const ImageF& image, int channel, const ImageF& mask, const Box& box) {
+  double sum = 0;
+  std::size_t count = 0;
+  for (int y = box.y0; y < box.y1; ++y)
+    for (int x = box.x0; x < box.x1; ++x)
+      if (mask.at(x, y, 0) >= 0.5f) sum += image.at(x, y, channel), ++count;
+  return count ? sum / count : NAN;
+}
+
+Scores mean_of(const std::vector<Scores>& all) {
+  Scores mean;
+  for (const Scores& s : all) {
+    mean.l1 += s.l1 / all.size();
+    mean.rmse += s.rmse / all.size();
+    mean.psnr += s.psnr / all.size();
+    mean.ssim += s.ssim / all.size();
+  }
+  return mean;
+}
+
+nlohmann::json scores_json(const Scores& s) {
+  return {{"l1", s.l1}, {"rmse", s.rmse}, {"psnr", s.psnr}, {"ssim", s.ssim}};
+}
+
+}  // namespace
+
+bool has_ground_truth_maps(const io::RgbdSequence& sequence) {
+  return sequence.format == "glint" && !sequence.frames.empty() &&
+         fs::exists(ground_truth_path(sequence, 0, "segment", ".png"));
+}
+
+Image<std::int32_t> read_ground_truth_segments(const io::RgbdSequence& sequence, std::size_t i) {
+  const ImageF values = read_checked(ground_truth_path(sequence, i, "segment", ".png"), 1);
+  Image<std::int32_t> ids(values.width(), values.height(), 1);
+  for (std::size_t p = 0; p < values.pixel_count(); ++p)
+    ids.plane(0)[p] = std::int32_t(std::lround(values.plane(0)[p] * 65535.0f));
+  return ids;
+}
+
+GroundTruthMaps read_ground_truth_maps(const io::RgbdSequence& sequence, std::size_t i) {
+  GroundTruthMaps maps;
+  maps.kd = read_checked(ground_truth_path(sequence, i, "kd", ".exr"), 3);
+  maps.ks = read_checked(ground_truth_path(sequence, i, "ks", ".exr"), 3);
+  maps.alpha = read_checked(ground_truth_path(sequence, i, "alpha", ".exr"), 1);
+  maps.segment = read_ground_truth_segments(sequence, i);
+  return maps;
+}
+
+const char* quantity_name(Quantity quantity) {
+  switch (quantity) {
+    case Quantity::kd:
+      return "kd";
+    case Quantity::kd_refined:
+      return "kd_ref";
+    case Quantity::ks:
+      return "ks";
+    case Quantity::alpha:
+      return "alpha";
+    case Quantity::rgb:
+      return "rgb";
+    case Quantity::rgb_refined:
+      return "rgb_ref";
+  }
+  return "?";
+}
+
+void MaterialEvaluation::add_frame(int frame, const MaterialMaps& estimate,
+                                   const GroundTruthMaps& truth, const ImageF& input_rgb) {
+  const int width = truth.segment.width(), height = truth.segment.height();
+  const auto same_size = [&](const auto& image) {
+    return image.width() == width && image.height() == height;
+  };
+  if (!same_size(estimate.covered) || !same_size(truth.kd) || !same_size(input_rgb))
+    throw Error("material evaluation", "frame " + std::to_string(frame),
+                "estimate, ground truth and input differ in size");
+  const ImageF input_srgb = srgb_encoded(input_rgb);
+  const ImageF rgb = srgb_encoded(estimate.rgb), rgb_refined = srgb_encoded(estimate.rgb_refined);
+
+  std::set<int> objects(truth.segment.values().begin(), truth.segment.values().end());
+  objects.erase(0);
+  ImageF mask(width, height, 1);
+  for (int object : objects) {
+    Box box{width, height, 0, 0};
+    int covered = 0, pixels = 0;
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) {
+        const bool mine = truth.segment.at(x, y, 0) == object;
+        pixels += mine;
+        const bool scored = mine && estimate.covered.at(x, y, 0) > 0.5f;
+        mask.at(x, y, 0) = scored ? 1.0f : 0.0f;
+        if (!scored) continue;
+        ++covered;
+        box = {std::min(box.x0, x), std::min(box.y0, y), std::max(box.x1, x + 1),
+               std::max(box.y1, y + 1)};
+      }
+    if (covered < min_pixels_) continue;
+    auto& scores = frames_[object];
+    scores[Quantity::kd].push_back(score(truth.kd, estimate.kd, mask, box));
+    scores[Quantity::kd_refined].push_back(score(truth.kd, estimate.kd_refined, mask, box));
+    scores[Quantity::ks].push_back(score(truth.ks, estimate.ks, mask, box));
+    scores[Quantity::alpha].push_back(score(truth.alpha, estimate.alpha, mask, box));
+    scores[Quantity::rgb].push_back(score(input_srgb, rgb, mask, box));
+    scores[Quantity::rgb_refined].push_back(score(input_srgb, rgb_refined, mask, box));
+
+    Sample sample;
+    sample.frame = frame;
+    sample.kd = masked_mean(estimate.kd, 0, mask, box);
+    sample.kd_refined = masked_mean(estimate.kd_refined, 0, mask, box);
+    sample.ks = masked_mean(estimate.ks, 0, mask, box);
+    sample.alpha = masked_mean(estimate.alpha, 0, mask, box);
+    sample.rgb = masked_mean(rgb, 0, mask, box);
+    sample.rgb_refined = masked_mean(rgb_refined, 0, mask, box);
+    sample.true_kd = masked_mean(truth.kd, 0, mask, box);
+    sample.true_ks = masked_mean(truth.ks, 0, mask, box);
+    sample.true_alpha = masked_mean(truth.alpha, 0, mask, box);
+    sample.true_rgb = masked_mean(input_srgb, 0, mask, box);
+    sample.coverage = double(covered) / pixels;
+    series_[object].push_back(sample);
+  }
+}
+
+std::map<int, std::map<Quantity, Scores>> MaterialEvaluation::table() const {
+  std::map<int, std::map<Quantity, Scores>> table;
+  for (const auto& [object, quantities] : frames_)
+    for (const auto& [quantity, all] : quantities) table[object][quantity] = mean_of(all);
+  return table;
+}
+
+std::map<Quantity, Scores> MaterialEvaluation::average() const {
+  std::map<Quantity, std::vector<Scores>> per_object;
+  for (const auto& [object, quantities] : table())
+    for (const auto& [quantity, scores] : quantities) per_object[quantity].push_back(scores);
+  std::map<Quantity, Scores> average;
+  for (const auto& [quantity, all] : per_object) average[quantity] = mean_of(all);
+  return average;
+}
+
+nlohmann::json MaterialEvaluation::to_json() const {
+  nlohmann::json objects = nlohmann::json::object();
+  for (const auto& [object, quantities] : table()) {
+    nlohmann::json entry;
+    for (const auto& [quantity, scores] : quantities)
+      entry[quantity_name(quantity)] = scores_json(scores);
+    entry["frames"] = frames_.at(object).begin()->second.size();
+    objects[std::to_string(object)] = entry;
+  }
+  nlohmann::json average_json;
+  for (const auto& [quantity, scores] : average())
+    average_json[quantity_name(quantity)] = scores_json(scores);
+  nlohmann::json series = nlohmann::json::object();
+  for (const auto& [object, samples] : series_) {
+    nlohmann::json rows = nlohmann::json::array();
+    for (const Sample& s : samples)
+      rows.push_back({s.frame, s.kd, s.kd_refined, s.ks, s.alpha, s.rgb, s.rgb_refined, s.true_kd,
+                      s.true_ks, s.true_alpha, s.true_rgb, s.coverage});
+    series[std::to_string(object)] = rows;
+  }
+  return {{"objects", objects},
+          {"average", average_json},
+          {"series_columns",
+           {"frame", "kd_r", "kd_ref_r", "ks_r", "alpha", "rgb_r", "rgb_ref_r", "true_kd_r",
+            "true_ks_r", "true_alpha", "true_rgb_r", "coverage"}},
+          {"series", series}};
+}
+
+}  // namespace glint::reflectance

@@ -1,0 +1,54 @@
+#pragma once
+// Re-rendering of the reconstructed model from a camera (paper 1 §4.2, Figs 2-3, Table 1): the
+// surface seen by the camera (a TSDF ray cast) is looked up in the observation grid for its
+// segment and that segment's fused Ward material; the refined diffuse albedo is interpolated
+// trilinearly between the surrounding observation voxels of the same segment (§3.7); each
+// pixel is shaded with the Ward BRDF under the estimated near-field point lights (direct light,
+// no shadows, as the albedo refinement assumes), once with the HemiCNN's kd and once with the
+// refined kd.
+#include <cstdint>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/image.h"
+#include "fusion/raycast.h"
+#include "reflectance/observation_grid.h"
+#include "reflectance/specular_estimation.h"
+#include "render/scene.h"
+
+namespace glint::reflectance {
+
+struct MaterialMaps {
+  ImageF kd, kd_refined, ks;    // 3 channels, linear albedo
+  ImageF alpha;                 // 1 channel
+  ImageF rgb, rgb_refined;      // 3 channels: radiance * exposure, clipped to [0, 1] (linear)
+  Image<std::int32_t> segment;  // global segment id, 0 = none
+  ImageF covered;               // 1 where the model was hit and its segment has a material
+};
+
+// Outgoing radiance at surface point p with unit normal n seen from `eye`, eq. (6) summed over
+// the point lights (L_l = intensity / r^2).
+Eigen::Vector3f shade_ward(const render::WardMaterial& material, const Eigen::Vector3f& p,
+                           const Eigen::Vector3f& n, const Eigen::Vector3f& eye,
+                           const std::vector<render::PointLight>& lights);
+
+// Refined kd at p: trilinear weights of the 8 observation voxels around p, restricted to those
+// of `segment` with a refined albedo and renormalised; false when there is none.
+bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& p, int segment,
+                            Eigen::Vector3f& kd);
+
+// The material at surface point p: the segment of the voxel holding p (else of the nearest
+// labelled neighbour voxel), its fused Ward parameters, and the same with the refined kd.
+// False when p lies in no segment with a material yet.
+struct PointMaterial {
+  int segment = 0;
+  render::WardMaterial fused, refined;
+};
+bool material_at(const ObservationGrid& grid, const SpecularEstimator& materials,
+                 const Eigen::Vector3f& p, PointMaterial& material);
+
+MaterialMaps render_material_maps(const fusion::SurfaceView& surface, const Pose& camera_to_world,
+                                  const ObservationGrid& grid, const SpecularEstimator& materials,
+                                  const std::vector<render::PointLight>& lights, float exposure);
+
+}  // namespace glint::reflectance

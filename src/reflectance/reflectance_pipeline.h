@@ -1,0 +1,77 @@
+#pragma once
+// The online reflectance pipeline (paper 1 §3, Fig. 1), one call per RGB-D frame:
+//   geometry      TSDF fusion with tracking or ground-truth poses (fusion/fusion_pipeline.h)
+//   observations  the coarse observation grid collects (radiance, direction) pairs (§3.4)
+//   segmentation  per-frame depth segmentation, propagated to global segment ids (§3.5), or
+//                 the sequence's ground-truth segment ids
+//   specular      HemiCNN per segment on 25 sampled voxels, fused over time (§3.6)
+//   albedo        per-voxel diffuse albedo from eq. (7) with the segment's ks, alpha (§3.7)
+// Stage times go into timings() as "geometry", "observations", "segmentation", "specular",
+// "albedo" and "total" (milliseconds per frame), the rows of paper 1 Tables 2-3.
+#include <vector>
+
+#include "core/timer.h"
+#include "fusion/fusion_pipeline.h"
+#include "io/rgbd_sequence.h"
+#include "reflectance/depth_segmentation.h"
+#include "reflectance/hemicnn.h"
+#include "reflectance/observation_grid.h"
+#include "reflectance/segment_map.h"
+#include "reflectance/specular_estimation.h"
+#include "render/scene.h"
+
+namespace glint::reflectance {
+
+struct ReflectanceParams {
+  fusion::FusionParams geometry{.integrate_colour = false};
+  ObservationGridParams observations;
+  DepthSegmentationParams segmentation;
+  SegmentMapParams segments;
+  SpecularParams specular;
+  // Radiance = pixel colour / exposure; the lights are in the same radiance units
+  // (reflectance/light_estimation.h).
+  float exposure = 1;
+};
+
+struct ReflectanceFrame {
+  fusion::FrameResult geometry;
+  int observed_voxels = 0;
+  int segments = 0;  // global segments seen in this frame
+};
+
+class ReflectancePipeline {
+ public:
+  ReflectancePipeline(const Intrinsics& intrinsics, const ReflectanceParams& params,
+                      const HemiCnn& network, std::vector<render::PointLight> lights);
+
+  // One frame. ground_truth_segments: per-pixel object ids (the synthetic gt/segment image) to
+  // use instead of the depth segmentation, or nullptr. Throws glint::Error for a frame that
+  // does not fit (sizes) or an exhausted pool.
+  ReflectanceFrame process(const io::RgbdFrame& frame,
+                           const Image<std::int32_t>* ground_truth_segments = nullptr);
+
+  const fusion::TsdfVolume& geometry() const { return geometry_.volume(); }
+  const ObservationGrid& observations() const { return grid_; }
+  const SegmentMap& segments() const { return segment_map_; }
+  const SpecularEstimator& materials() const { return specular_; }
+  const std::vector<render::PointLight>& lights() const { return lights_; }
+  const StageTimings& timings() const { return timings_; }
+  const Intrinsics& intrinsics() const { return intrinsics_; }
+  float exposure() const { return params_.exposure; }
+  int frames_processed() const { return frame_; }
+
+ private:
+  void refine_albedo_of_visible();
+
+  Intrinsics intrinsics_;
+  ReflectanceParams params_;
+  fusion::FusionPipeline geometry_;
+  ObservationGrid grid_;
+  SegmentMap segment_map_;
+  SpecularEstimator specular_;
+  std::vector<render::PointLight> lights_;
+  StageTimings timings_;
+  int frame_ = 0;
+};
+
+}  // namespace glint::reflectance

@@ -1,0 +1,75 @@
+#include "reflectance/specular_estimation.h"
+
+#include <tbb/parallel_for_each.h>
+
+#include "core/log.h"
+#include "render/perceptual.h"
+
+namespace glint::reflectance {
+namespace {
+
+using Parameters = ClampedRunningMean<7>::Vector;
+
+Parameters to_vector(const render::WardMaterial& m) {
+  Parameters p;
+  p << m.kd, m.ks, m.alpha;
+  return p;
+}
+
+render::WardMaterial to_material(const Parameters& p) {
+  render::WardMaterial m;
+  m.kd = p.head<3>();
+  m.ks = p.segment<3>(3);
+  m.alpha = p[6];
+  return m;
+}
+
+}  // namespace
+
+SpecularEstimator::SpecularEstimator(const HemiCnn& network, const SpecularParams& params)
+    : network_(network), params_(params) {
+  hemi_.projection = network.projection();
+}
+
+const SegmentMaterial* SpecularEstimator::material(int segment) const {
+  const auto found = materials_.find(segment);
+  return found == materials_.end() ? nullptr : &found->second;
+}
+
+void SpecularEstimator::update(const ObservationGrid& grid, const SegmentMap& segment_map,
+                               const std::vector<int>& segments, int frame) {
+  const int count = params_.voxels_per_estimate;
+  const int image_floats = 3 * hemi_.size * hemi_.size;
+  std::vector<std::optional<render::WardMaterial>> estimates(segments.size());
+  tbb::parallel_for(std::size_t(0), segments.size(), [&](std::size_t i) {
+    // Seeded per (seed, frame, segment): the same run gives the same samples on any thread.
+    std::mt19937_64 random(params_.seed * 0x9E3779B97F4A7C15ull + std::uint64_t(frame) * 7919u +
+                           std::uint64_t(segments[i]));
+    std::vector<int> voxels(count);
+    const int sampled = segment_map.sample(grid, segments[i], count, params_.min_observations,
+                                           random, voxels.data());
+    if (sampled < count) {
+      log().debug("frame {}: segment {} has {} of {} voxels with {} observations (ring {})", frame,
+                  segments[i], sampled, count, params_.min_observations,
+                  segment_map.ring_size(segments[i]));
+      return;
+    }
+    std::vector<float> images(std::size_t(count) * image_floats);
+    for (int k = 0; k < count; ++k)
+      make_hemi_image(grid.observations(voxels[k]), grid.observation_count(voxels[k]),
+                      grid.normal(voxels[k]), hemi_, images.data() + std::size_t(k) * image_floats);
+    estimates[i] = render::from_perceptual(network_.predict(images.data(), count));
+  });
+  for (std::size_t i = 0; i < segments.size(); ++i) {
+    if (!estimates[i]) continue;
+    auto fused = fused_.try_emplace(segments[i], params_.fusion_divisor).first;
+    fused->second.add(to_vector(*estimates[i]));
+    SegmentMaterial& material = materials_[segments[i]];
+    material.ward = to_material(fused->second.mean());
+    material.latest = *estimates[i];
+    ++material.estimates;
+    material.last_frame = frame;
+  }
+}
+
+}  // namespace glint::reflectance
