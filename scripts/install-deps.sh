@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake pkg-config
+  build-essential cmake pkg-config python3
   libeigen3-dev libnanoflann-dev libtbb-dev
   # libtorch's CPU convolutions call BLAS; OpenBLAS (OpenMP-threaded, like libtorch) instead
   # of the reference BLAS makes the denoisers' U-Net several times faster.

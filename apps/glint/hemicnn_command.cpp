@@ -251,7 +251,7 @@ void register_hemicnn_train(CLI::App& hemicnn) {
       "training sequence; loss eq. (5) with Lab in units of 100; Adam lr {}, batches of {};\n"
       "the last {} % of the sequences are held out and the weights with the lowest validation\n"
       "loss are kept. The paper trains 150k batches on a GPU; the default {} batches take\n"
-      "about 10 minutes on 2 CPU cores.\n"
+      "8-10 minutes on one CPU core (44-55 batches/s measured; see --torch-threads).\n"
       "Examples:\n"
       "  # the modified HemiCNN (paper 1: lambda_d 0.1, lambda_l 0.3, parabolic hemi-images)\n"
       "  glint hemicnn train hemi/parabolic -o models/hemicnn.json --report train.json\n"

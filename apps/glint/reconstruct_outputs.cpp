@@ -110,10 +110,12 @@ void write_materials_json(const std::string& path,
 void write_frame_pictures(const std::string& output, int frame, const ImageF& input_colour,
                           const reflectance::MaterialMaps& maps) {
   const std::string stem = (fs::path(output) / "frames" / fmt::format("{:06d}", frame)).string();
-  io::write_image(stem + "-input.png", srgb_picture(input_colour));
-  io::write_image(stem + "-render.png", srgb_picture(maps.rgb_refined));
+  const ImageF input = srgb_picture(input_colour), render = srgb_picture(maps.rgb_refined),
+               albedo = srgb_picture(maps.kd_refined);
+  io::write_image(stem + "-input.png", input);
+  io::write_image(stem + "-render.png", render);
   io::write_image(stem + "-render-hemicnn.png", srgb_picture(maps.rgb));
-  io::write_image(stem + "-albedo.png", srgb_picture(maps.kd_refined));
+  io::write_image(stem + "-albedo.png", albedo);
   ImageF segments(maps.segment.width(), maps.segment.height(), 3);
   for (int y = 0; y < segments.height(); ++y)
     for (int x = 0; x < segments.width(); ++x) {
@@ -121,6 +123,15 @@ void write_frame_pictures(const std::string& output, int frame, const ImageF& in
       for (int c = 0; c < 3; ++c) segments.at(x, y, c) = colour[c];
     }
   io::write_image(stem + "-segments.png", segments);
+  // One picture to look at: input | re-rendering | refined albedo | segments.
+  const std::array<const ImageF*, 4> row{&input, &render, &albedo, &segments};
+  const int width = input.width(), height = input.height();
+  ImageF overview(4 * width, height, 3);
+  for (int k = 0; k < 4; ++k)
+    for (int c = 0; c < 3; ++c)
+      for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) overview.at(k * width + x, y, c) = row[k]->at(x, y, c);
+  io::write_image(stem + "-overview.png", overview);
 }
 
 void write_material_plots(const std::string& path,

@@ -21,7 +21,8 @@ nlohmann::json materials_json(const reflectance::ReflectancePipeline& pipeline);
 void write_materials_json(const std::string& path,
                           const reflectance::ReflectancePipeline& pipeline);
 
-// OUT/frames/NNNNNN-{input,render,render-hemicnn,albedo,segments}.png (8-bit sRGB).
+// OUT/frames/NNNNNN-{input,render,render-hemicnn,albedo,segments}.png (8-bit sRGB) and
+// NNNNNN-overview.png (input, re-rendering, refined albedo and segments side by side).
 void write_frame_pictures(const std::string& output, int frame, const ImageF& input_colour,
                           const reflectance::MaterialMaps& maps);
 

@@ -17,11 +17,11 @@
 //                 (L, a, b, c_r, c_g, c_b, d); de-standardised with target_mean / target_std;
 //                 then clamped: L to [0, 100], c >= 0, d to [kMinD, kMaxD]
 // With the defaults (conv 16, 32, 32; 128; 64) this has 39,559 trainable parameters (about
-// 0.8 MB as JSON) and costs 155k multiply-adds per hemi-image. Why so small: libtorch trains it
-// on a 2-core CPU at ~25 batches of 32 x 25 images per second; a stride-1 first layer (16
-// channels at 15 x 15) would be 4x slower to train. Weight layouts are TensorFlow's (the paper
-// trained in TensorFlow), which suit vectorising over output channels: conv [ky][kx][in][out]
-// (HWIO), dense [in][out].
+// 0.9 MB as JSON) and costs 155k multiply-adds per hemi-image: predict() takes ~0.3 ms per set
+// of 25 on one core of the project's CPU. Why so small: libtorch trains it on one CPU core at
+// 44-55 batches of 32 sets per second; a stride-1 first layer (16 channels at 15 x 15) trained
+// 4-5x slower. Weight layouts are TensorFlow's (the paper trained in TensorFlow), which suit
+// vectorising over output channels: conv [ky][kx][in][out] (HWIO), dense [in][out].
 #include <array>
 #include <cstddef>
 #include <nlohmann/json.hpp>
@@ -99,7 +99,8 @@ class HemiCnn {
 
   // The material of one set of `count` >= 1 hemi-images, images[count][3][S][S] (CHW each,
   // linear radiance). The result does not depend on the order of the images. Thread-safe (const);
-  // no allocation once `scratch` has grown. Throws glint::Error when count < 1.
+  // no allocation once `scratch` has grown. Throws glint::Error when count < 1. Expects a
+  // consistent model (load() and training give one; call check() after editing members).
   render::PerceptualWard predict(const float* images, int count, HemiCnnScratch& scratch) const;
   // The same with a thread_local scratch.
   render::PerceptualWard predict(const float* images, int count) const;

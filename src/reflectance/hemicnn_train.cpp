@@ -155,7 +155,8 @@ void copy_turned(const float* source, float* target, int size, int quarter_turns
       }
 }
 
-// Draws sets of distinct images of one sequence into a [sets, count, 3, S, S] buffer.
+// Draws one set: `count` distinct random images of a sequence, all turned alike, written as
+// count x 3 x S x S floats.
 class SetSampler {
  public:
   SetSampler(const HemiDataset& data, int count) : data_(data), count_(count) {}

@@ -28,14 +28,14 @@
 namespace glint::reflectance {
 
 struct HemiCnnTrainParams {
-  int batches = 12000;  // ~10 minutes on this project's 2-core CPU (models/README.md)
+  int batches = 25000;  // 8-10 minutes at the measured 44-55 batches/s (one thread)
   int batch_size = 32;  // sets per batch
   int set_size = 25;    // hemi-images per set (paper 1: 25 voxels per segment)
   double learning_rate = 1e-4;
   HemiCnnLossWeights loss;           // eq. (5): lambda_d 0.1, lambda_l 0.3 (Kim et al.: 1, 1)
   double validation_fraction = 0.1;  // last sequences by index; 0 = keep the last weights
   int validation_sets = 8;           // fixed sets per validation sequence
-  int log_every = 250;               // batches between validation evaluations / log lines
+  int log_every = 500;               // batches between validation evaluations / log lines
   bool rotate = true;                // random quarter turns, the same for a whole set
   int threads = 1;                   // torch intra-op threads (see above)
   std::uint64_t seed = 1;

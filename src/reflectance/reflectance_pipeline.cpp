@@ -4,6 +4,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "fusion/depth_maps.h"
 #include "reflectance/albedo_refinement.h"
 
 namespace glint::reflectance {
@@ -38,6 +39,27 @@ void ReflectancePipeline::refine_albedo_of_visible() {
   });
 }
 
+Image<std::int32_t> ReflectancePipeline::segment_frame(const ImageF& depth_m) const {
+  ImageF depth = depth_m;
+  Intrinsics intrinsics = intrinsics_;
+  DepthSegmentationParams params = params_.segmentation;
+  for (int level = 0; level < params_.segmentation_halvings; ++level) {
+    depth = fusion::downsample_depth(depth, params_.geometry.tracking.bilateral.sigma_depth_m);
+    intrinsics = intrinsics.scaled(0.5);
+    params.min_segment_px = std::max(1, params.min_segment_px / 4);
+  }
+  const DepthSegmentation coarse = segment_depth(depth, intrinsics, params);
+  if (params_.segmentation_halvings == 0) return coarse.labels;
+  // Every full-resolution pixel takes the label of the coarse pixel covering it.
+  const int shift = params_.segmentation_halvings;
+  Image<std::int32_t> labels(depth_m.width(), depth_m.height(), 1);
+  for (int y = 0; y < labels.height(); ++y)
+    for (int x = 0; x < labels.width(); ++x)
+      labels.at(x, y, 0) = coarse.labels.at(std::min(x >> shift, depth.width() - 1),
+                                            std::min(y >> shift, depth.height() - 1), 0);
+  return labels;
+}
+
 ReflectanceFrame ReflectancePipeline::process(const io::RgbdFrame& frame,
                                               const Image<std::int32_t>* ground_truth_segments) {
   ReflectanceFrame result;
@@ -64,9 +86,7 @@ ReflectanceFrame ReflectancePipeline::process(const io::RgbdFrame& frame,
                   "ground-truth segment image differs in size from the depth image");
     segment_map_.update(grid_, grid_.visible(), *ground_truth_segments, true);
   } else {
-    const DepthSegmentation segmentation =
-        segment_depth(frame.depth_m, intrinsics_, params_.segmentation);
-    segment_map_.update(grid_, grid_.visible(), segmentation.labels, false);
+    segment_map_.update(grid_, grid_.visible(), segment_frame(frame.depth_m), false);
   }
   result.segments = int(segment_map_.frame_segments().size());
   timings_.add("segmentation", stage.elapsed_ms());

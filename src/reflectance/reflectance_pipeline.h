@@ -25,7 +25,11 @@ namespace glint::reflectance {
 struct ReflectanceParams {
   fusion::FusionParams geometry{.integrate_colour = false};
   ObservationGridParams observations;
-  DepthSegmentationParams segmentation;
+  DepthSegmentationParams segmentation;  // min_segment_px at full resolution
+  // The depth segmentation runs on the depth image halved this many times (KinectFusion's
+  // edge-preserving block average, fusion/depth_maps.h): a quarter of the pixels per level,
+  // and smoother normals on noisy sensors; voxels look their label up at the coarser pixel.
+  int segmentation_halvings = 1;
   SegmentMapParams segments;
   SpecularParams specular;
   // Radiance = pixel colour / exposure; the lights are in the same radiance units
@@ -62,6 +66,7 @@ class ReflectancePipeline {
 
  private:
   void refine_albedo_of_visible();
+  Image<std::int32_t> segment_frame(const ImageF& depth_m) const;
 
   Intrinsics intrinsics_;
   ReflectanceParams params_;

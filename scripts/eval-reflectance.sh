@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# The reflectance pipeline's evaluation (paper 1 §4, Tables 1-3, Figs 2 and 4) on glint's
+# synthetic scenes: renders each scene (300 frames, 512x424, no shadows: the pipeline's image
+# model has none) and its low-exposure light capture, estimates the lights (glint lights), then
+# runs glint reconstruct with ground-truth poses:
+#   - with ground-truth and with glint's own segmentation, at 2 cm observation voxels;
+#   - with the modified (parabolic, lambda_d 0.1, lambda_l 0.3) and the unmodified
+#     (orthographic, lambda 1) HemiCNN, ground-truth segmentation;
+#   - at 1 cm observation voxels (Table 3 timings).
+# Reports: OUT/<scene>-<variant>/report.json; a summary table: OUT/summary.md.
+#   scripts/eval-reflectance.sh GLINT DATA [OUT] [SCENES] [FRAMES]
+set -euo pipefail
+GLINT=${1:?usage: eval-reflectance.sh GLINT DATA [OUT] [SCENES] [FRAMES]}
+DATA=${2:?usage: eval-reflectance.sh GLINT DATA [OUT] [SCENES] [FRAMES]}
+OUT=${3:-build/eval-reflectance}
+SCENES=${4:-bunnies cubes office}
+FRAMES=${5:-300}
+MODELS=$(dirname "$0")/../models
+mkdir -p "$OUT"
+for scene in $SCENES; do
+  seq="$OUT/seq-$scene"
+  cap="$OUT/capture-$scene"
+  [[ -d "$seq" ]] || "$GLINT" --quiet synth "$scene" -o "$seq" --frames "$FRAMES" --no-shadows \
+    --data "$DATA"
+  [[ -d "$cap" ]] || "$GLINT" --quiet synth lights --scene "$scene" -o "$cap" --frames 60 \
+    --data "$DATA"
+  "$GLINT" --quiet lights "$cap" -o "$OUT/lights-$scene.json" --report "$OUT/lights-$scene-report.json"
+  run() {  # run NAME ARGS...
+    local name=$1
+    shift
+    "$GLINT" --quiet reconstruct "$seq" --lights "$OUT/lights-$scene.json" --gt-poses \
+      -o "$OUT/$scene-$name" --report "$OUT/$scene-$name.json" "$@" \
+      > "$OUT/$scene-$name.txt"
+  }
+  run gtseg --gt-segmentation --model "$MODELS/hemicnn.json"
+  run ownseg --model "$MODELS/hemicnn.json"
+  run unmodified --gt-segmentation --model "$MODELS/hemicnn-unmodified.json"
+  run gtseg-1cm --gt-segmentation --model "$MODELS/hemicnn.json" --obs-voxel 0.01 --eval-every 0
+done
+python3 "$(dirname "$0")/reflectance-summary.py" "$OUT" $SCENES > "$OUT/summary.md"
+echo "eval-reflectance: reports in $OUT, summary in $OUT/summary.md"

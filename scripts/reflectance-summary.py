@@ -1,0 +1,85 @@
+#!/usr/bin/env python3
+"""Summary of scripts/eval-reflectance.sh: paper 1 Table 1 (per object and averaged L1, RMSE,
+PSNR, SSIM of kd, refined kd, ks, alpha, RGB, refined RGB) per scene and variant, the modified
+vs unmodified HemiCNN, and Tables 2-3 (per-stage milliseconds per frame), as Markdown.
+usage: reflectance-summary.py OUT SCENE..."""
+import json
+import os
+import sys
+
+PAPER_AVERAGE = {  # paper 1 Table 1, "avg" column (bunnies, 1000 frames)
+    "kd": (0.11, 0.13, 18.33, 0.93), "kd_ref": (0.05, 0.09, 22.20, 0.95),
+    "ks": (0.04, 0.05, 28.82, 0.98), "alpha": (0.04, 0.06, 22.25, 0.98),
+    "rgb": (0.13, 0.18, 25.95, 0.94), "rgb_ref": (0.08, 0.15, 27.61, 0.95)}
+PAPER_TOTALS = {"2cm": {"cubes": 17.294, "bunnies": 25.023, "office": 29.763},
+                "1cm": {"cubes": 23.919, "bunnies": 44.467, "office": 54.794}}
+QUANTITIES = ["kd", "kd_ref", "ks", "alpha", "rgb", "rgb_ref"]
+METRICS = ["l1", "rmse", "psnr", "ssim"]
+STAGES = ["geometry", "observations", "segmentation", "specular", "albedo", "total"]
+
+
+def load(out, scene, variant):
+    path = os.path.join(out, f"{scene}-{variant}.json")
+    return json.load(open(path)) if os.path.exists(path) else None
+
+
+def table1(report, title):
+    ev = report["evaluation"]
+    objects = sorted(ev["objects"], key=int)
+    lines = [f"#### {title}", "",
+             "| quantity | metric | " + " | ".join(f"S{o}" for o in objects) + " | avg | paper avg |",
+             "|---" * (len(objects) + 4) + "|"]
+    for q in QUANTITIES:
+        for m_index, m in enumerate(METRICS):
+            cells = [f"{ev['objects'][o][q][m]:.3f}" for o in objects]
+            lines.append(f"| {q} | {m} | " + " | ".join(cells) +
+                         f" | **{ev['average'][q][m]:.3f}** | {PAPER_AVERAGE[q][m_index]} |")
+    frames = {o: ev["objects"][o]["frames"] for o in objects}
+    lines += ["", f"Frames scored per object: {frames}", ""]
+    return lines
+
+
+def averages_row(report, name):
+    a = report["evaluation"]["average"]
+    return (f"| {name} | " + " | ".join(f"{a[q]['l1']:.3f}" for q in QUANTITIES) +
+            f" | {a['rgb_ref']['psnr']:.2f} |")
+
+
+def main():
+    out, scenes = sys.argv[1], sys.argv[2:]
+    lines = ["# Reflectance pipeline evaluation", ""]
+    lines += ["## Averaged L1 (and refined-RGB PSNR) per variant", "",
+              "| scene / variant | " + " | ".join(f"{q} L1" for q in QUANTITIES) +
+              " | rgb_ref PSNR |", "|---" * 8 + "|",
+              "| paper (bunnies, own pipeline) | " +
+              " | ".join(str(PAPER_AVERAGE[q][0]) for q in QUANTITIES) + " | 27.61 |"]
+    for scene in scenes:
+        for variant in ["gtseg", "ownseg", "unmodified"]:
+            r = load(out, scene, variant)
+            if r and r.get("evaluation"):
+                lines.append(averages_row(r, f"{scene} / {variant}"))
+    lines.append("")
+    for scene in scenes:
+        for variant in ["gtseg", "ownseg", "unmodified"]:
+            r = load(out, scene, variant)
+            if r and r.get("evaluation"):
+                lines += table1(r, f"{scene}, {variant}")
+    for grid, variant in [("2cm", "gtseg"), ("1cm", "gtseg-1cm")]:
+        lines += [f"## Per-stage ms per frame (median; mean in brackets), {grid} observation grid",
+                  "", "| stage | " + " | ".join(scenes) + " |", "|---" * (len(scenes) + 1) + "|"]
+        reports = {s: load(out, s, variant) for s in scenes}
+        for stage in STAGES:
+            cells = []
+            for s in scenes:
+                r = reports[s]
+                t = r["timings_ms"].get(stage) if r else None
+                cells.append(f"{t['median']:.1f} ({t['mean']:.1f})" if t else "-")
+            lines.append(f"| {stage} | " + " | ".join(cells) + " |")
+        lines.append("| paper total (GTX 1080) | " +
+                     " | ".join(str(PAPER_TOTALS[grid].get(s, "-")) for s in scenes) + " |")
+        lines.append("")
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
