@@ -10,4 +10,6 @@ mkdir -p "$OUT"
   --data "$DATA/pointclouds/default-eval" --json "$OUT/edges_throughput.json"
 "$BUILD/bench/denoise/denoise_speed" --json "$OUT/denoise_speed.json"
 "$BUILD/bench/render/render_speed" --data "$DATA" --threads 2 --json "$OUT/render_speed.json"
-echo "bench: results in $OUT (the denoising protocol: scripts/eval-denoise.sh)"
+"$BUILD/bench/reflectance/reflectance_kernels" --benchmark_out="$OUT/reflectance_kernels.json" \
+  --benchmark_out_format=json
+echo "bench: results in $OUT (the reflectance pipeline: scripts/eval-reflectance.sh; the denoising protocol: scripts/eval-denoise.sh)"

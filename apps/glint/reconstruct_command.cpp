@@ -20,6 +20,7 @@
 #include "io/image_io.h"
 #include "io/json_report.h"
 #include "io/rgbd_sequence.h"
+#include "io/trajectory.h"
 #include "reconstruct_outputs.h"
 #include "reflectance/light_estimation.h"
 #include "reflectance/material_evaluation.h"
@@ -45,6 +46,7 @@ struct ReconstructOptions {
   bool ground_truth_segmentation = false;
   int evaluate_every = 5;
   int render_every = 0;  // 0: only the last frame
+  std::string views;     // TUM trajectory of extra poses to re-render at the end
   reflectance::ReflectanceParams params;
 };
 
@@ -95,6 +97,9 @@ void run_reconstruct(ReconstructOptions options) {
   options.params.exposure =
       options.exposure.value_or(reflectance::capture_exposure(options.sequence));
   const reflectance::LightEstimate lights = load_lights(options);
+  const std::vector<io::StampedPose> views = options.views.empty()
+                                                 ? std::vector<io::StampedPose>{}
+                                                 : io::read_tum_trajectory(options.views);
   const std::string model_path = options.model.empty()
                                      ? (fs::path(models_directory()) / "hemicnn.json").string()
                                      : options.model;
@@ -143,6 +148,22 @@ void run_reconstruct(ReconstructOptions options) {
         if (render) write_frame_pictures(options.output, int(i), frame.colour, maps);
         command_timings.add("evaluate", watch.elapsed_ms());
       }
+      progress.advance();
+    }
+    progress.finish();
+  }
+
+  if (!options.views.empty()) {
+    // Re-renderings of the final model from any poses (e.g. views the camera never took).
+    fs::create_directories(fs::path(options.output) / "views");
+    ProgressBar progress("views", views.size());
+    for (std::size_t k = 0; k < views.size(); ++k) {
+      const fusion::SurfaceView view =
+          fusion::raycast(pipeline.geometry(), sequence.intrinsics, views[k].pose);
+      const reflectance::MaterialMaps maps = reflectance::render_material_maps(
+          view, views[k].pose, pipeline.observations(), pipeline.materials(), pipeline.lights(),
+          pipeline.exposure());
+      write_view_pictures((fs::path(options.output) / "views").string(), int(k), maps);
       progress.advance();
     }
     progress.finish();
@@ -243,6 +264,9 @@ void register_reconstruct_command(CLI::App& app) {
       ->capture_default_str();
   command->add_option("--render-every", options->render_every,
                       "Write re-rendered pictures of every N-th frame (0 = the last only)");
+  command->add_option("--views", options->views,
+                      "TUM trajectory (camera-to-world) of extra poses to re-render the final "
+                      "model from, into OUT/views/");
   command->add_option("--seed", params.specular.seed, "Seed of the voxel sampling")
       ->capture_default_str();
   command->add_option("--report", options->report,

@@ -107,15 +107,21 @@ void write_materials_json(const std::string& path,
   io::write_json(path, materials_json(pipeline));
 }
 
+void write_view_pictures(const std::string& folder, int index,
+                         const reflectance::MaterialMaps& maps) {
+  const std::string stem = (fs::path(folder) / fmt::format("{:06d}", index)).string();
+  io::write_image(stem + "-render.png", srgb_picture(maps.rgb_refined));
+  io::write_image(stem + "-render-hemicnn.png", srgb_picture(maps.rgb));
+  io::write_image(stem + "-albedo.png", srgb_picture(maps.kd_refined));
+}
+
 void write_frame_pictures(const std::string& output, int frame, const ImageF& input_colour,
                           const reflectance::MaterialMaps& maps) {
-  const std::string stem = (fs::path(output) / "frames" / fmt::format("{:06d}", frame)).string();
-  const ImageF input = srgb_picture(input_colour), render = srgb_picture(maps.rgb_refined),
-               albedo = srgb_picture(maps.kd_refined);
+  const std::string folder = (fs::path(output) / "frames").string();
+  write_view_pictures(folder, frame, maps);
+  const std::string stem = (fs::path(folder) / fmt::format("{:06d}", frame)).string();
+  const ImageF input = srgb_picture(input_colour);
   io::write_image(stem + "-input.png", input);
-  io::write_image(stem + "-render.png", render);
-  io::write_image(stem + "-render-hemicnn.png", srgb_picture(maps.rgb));
-  io::write_image(stem + "-albedo.png", albedo);
   ImageF segments(maps.segment.width(), maps.segment.height(), 3);
   for (int y = 0; y < segments.height(); ++y)
     for (int x = 0; x < segments.width(); ++x) {
@@ -124,6 +130,7 @@ void write_frame_pictures(const std::string& output, int frame, const ImageF& in
     }
   io::write_image(stem + "-segments.png", segments);
   // One picture to look at: input | re-rendering | refined albedo | segments.
+  const ImageF render = srgb_picture(maps.rgb_refined), albedo = srgb_picture(maps.kd_refined);
   const std::array<const ImageF*, 4> row{&input, &render, &albedo, &segments};
   const int width = input.width(), height = input.height();
   ImageF overview(4 * width, height, 3);

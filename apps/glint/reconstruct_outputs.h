@@ -26,6 +26,10 @@ void write_materials_json(const std::string& path,
 void write_frame_pictures(const std::string& output, int frame, const ImageF& input_colour,
                           const reflectance::MaterialMaps& maps);
 
+// FOLDER/NNNNNN-{render,render-hemicnn,albedo}.png of a re-rendering from a free pose.
+void write_view_pictures(const std::string& folder, int index,
+                         const reflectance::MaterialMaps& maps);
+
 // Estimated (thin), refined (dashed) and true (bold) red kd, ks, alpha and red RGB of every
 // object over the evaluated frames (paper 1 Fig. 4).
 void write_material_plots(const std::string& path,

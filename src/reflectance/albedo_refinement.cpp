@@ -43,6 +43,7 @@ std::optional<Eigen::Vector3f> refine_albedo(const Observation* observations, in
   Eigen::Vector3f specular = Eigen::Vector3f::Zero();  // sum_k sum_l exp(gamma)/N L_l cos
   for (const render::PointLight& light : lights) {
     const Incidence in = incidence(light, position, normal);
+    if (in.irradiance.isZero()) continue;  // the light is behind the surface
     diffuse += in.irradiance;
     float lobe_sum = 0.0f;
     for (int k = 0; k < count; ++k)

@@ -26,6 +26,7 @@
 
 #include "core/camera.h"
 #include "core/image.h"
+#include "fusion/tsdf_sampler.h"
 #include "fusion/tsdf_volume.h"
 #include "fusion/voxel_block_hash.h"
 #include "reflectance/observation.h"
@@ -108,7 +109,8 @@ class ObservationGrid {
   }
   void allocate(const ImageF& depth_m, const Intrinsics& intrinsics, const Pose& camera_to_world,
                 int frame);
-  void refresh_surface(int v, const Eigen::Vector3f& centre, const fusion::TsdfVolume& geometry);
+  void refresh_surface(int v, const Eigen::Vector3f& centre, fusion::TsdfSampler& sampler,
+                       float tsdf_voxel_m);
 
   ObservationGridParams params_;
   int side_ = 2;
