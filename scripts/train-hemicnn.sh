@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Reproduces models/hemicnn.json (modified HemiCNN: parabolic hemi-images, lambda_d 0.1,
 # lambda_l 0.3) and models/hemicnn-unmodified.json (Kim et al.: orthographic, lambda 1):
-# renders glint's training set (400 sequences, seed 1), runs it through the pipeline's own
+# renders glint's training set (1,000 sequences, seed 1), runs it through the pipeline's own
 # observation collection into hemi-images, and trains both networks (seed 1, 30,000 batches
-# of 32, Adam lr 1e-4). About 6 + 1 + 2 x 12 minutes on 2 cores.
+# of 32, Adam lr 1e-4). About 10 + 2 + 12 minutes on 2 cores (the two trainings run side by side, one core each).
 #   scripts/train-hemicnn.sh GLINT DATA [WORK]
 set -euo pipefail
 GLINT=${1:?usage: train-hemicnn.sh GLINT DATA [WORK]}
@@ -11,7 +11,7 @@ DATA=${2:?usage: train-hemicnn.sh GLINT DATA [WORK]}
 WORK=${3:-build/hemicnn-training}
 MODELS=$(dirname "$0")/../models
 mkdir -p "$WORK"
-"$GLINT" synth training -o "$WORK/train" --sequences 400 --seed 1 --data "$DATA"
+"$GLINT" synth training -o "$WORK/train" --sequences 1000 --seed 1 --data "$DATA"
 [[ -f "$WORK/hemi/parabolic/index.json" ]] || "$GLINT" hemicnn dataset "$WORK/train" -o "$WORK/hemi"
 "$GLINT" hemicnn train "$WORK/hemi/parabolic" -o "$MODELS/hemicnn.json" --batches 30000 \
   --seed 1 --report "$WORK/train-modified.json" &

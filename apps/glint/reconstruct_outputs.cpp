@@ -88,6 +88,7 @@ nlohmann::json materials_json(const reflectance::ReflectancePipeline& pipeline) 
   }
   nlohmann::json segments = nlohmann::json::array();
   for (const auto& [id, material] : pipeline.materials().materials()) {
+    if (voxels[id] == 0) continue;  // merged into another segment
     nlohmann::json entry = ward_json(material.ward);
     entry["id"] = id;
     entry["latest"] = ward_json(material.latest);

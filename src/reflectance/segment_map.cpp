@@ -34,6 +34,27 @@ void SegmentMap::assign(ObservationGrid& grid, int voxel, int segment) {
   }
 }
 
+int SegmentMap::resolve(int segment) const {
+  while (segment < int(merged_into_.size()) && merged_into_[segment] > 0)
+    segment = merged_into_[segment];
+  return segment;
+}
+
+void SegmentMap::merge(ObservationGrid& grid, int kept, int gone) {
+  for (int v = 0; v < int(grid.voxel_count()); ++v)
+    if (grid.segment(v) == gone) grid.segment(v) = kept;
+  Ring& from = ring(gone);
+  Ring& into = ring(kept);
+  for (int voxel : from.voxels) {
+    if (int(into.voxels.size()) >= params_.ring_capacity) break;
+    into.voxels.push_back(voxel);
+  }
+  from = Ring{};
+  if (gone >= int(merged_into_.size())) merged_into_.resize(gone + 1, 0);
+  merged_into_[gone] = kept;
+  ++merges_;
+}
+
 void SegmentMap::update(ObservationGrid& grid, const std::vector<VisibleVoxel>& visible,
                         const Image<std::int32_t>& frame_labels, bool labels_are_global) {
   const std::int32_t* labels = frame_labels.plane(0);
@@ -46,12 +67,21 @@ void SegmentMap::update(ObservationGrid& grid, const std::vector<VisibleVoxel>& 
     std::map<int, std::map<int, int>> overlap;
     for (const VisibleVoxel& seen : visible)
       if (labels[seen.pixel] > 0) ++overlap[labels[seen.pixel]][grid.segment(seen.voxel)];
-    for (const auto& [label, counts] : overlap) {
+    for (const auto& [label, raw_counts] : overlap) {
+      // Ids merged earlier in this frame count as the segment they went into.
+      std::map<int, int> counts;
+      for (const auto& [id, count] : raw_counts) counts[id > 0 ? resolve(id) : 0] += count;
       int total = 0, best_id = 0, best_count = 0;
       for (const auto& [id, count] : counts) {
         total += count;
         if (id > 0 && count > best_count) best_id = id, best_count = count;
       }
+      for (const auto& [id, count] : counts)
+        if (id > 0 && id != best_id && count >= params_.merge_fraction * total &&
+            best_count >= params_.merge_fraction * total) {
+          merge(grid, best_id, id);  // one surface in this frame, two segments so far
+          best_count += count;
+        }
       if (best_id > 0 && best_count >= params_.min_overlap * total)
         global_of_label[label] = best_id;
       else if (total >= params_.min_new_segment_voxels) {
@@ -65,9 +95,9 @@ void SegmentMap::update(ObservationGrid& grid, const std::vector<VisibleVoxel>& 
     const int label = labels[seen.pixel];
     if (label <= 0) continue;
     const auto found = global_of_label.find(label);
-    if (found != global_of_label.end()) assign(grid, seen.voxel, found->second);
+    if (found != global_of_label.end()) assign(grid, seen.voxel, resolve(found->second));
   }
-  for (const auto& [label, id] : global_of_label) frame_segments_.push_back(id);
+  for (const auto& [label, id] : global_of_label) frame_segments_.push_back(resolve(id));
   std::sort(frame_segments_.begin(), frame_segments_.end());
   frame_segments_.erase(std::unique(frame_segments_.begin(), frame_segments_.end()),
                         frame_segments_.end());

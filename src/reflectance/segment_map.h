@@ -5,6 +5,9 @@
 //  - A frame segment takes the global id that most of its already-labelled voxels carry, when
 //    they are at least min_overlap of its voxels; otherwise, if it has min_new_segment_voxels
 //    voxels, it starts a new global segment.
+//  - When one frame segment covers two global segments, each with at least merge_fraction of
+//    its voxels, they are one surface seen in pieces before: the one covering fewer of them is
+//    merged into the other (its voxels relabelled, its ring appended).
 //  - A voxel's id changes only after repeated disagreement: agreeing frames raise its
 //    confidence (up to max_confidence), disagreeing ones lower it, and at 0 it switches.
 // Each global segment owns a fixed-size ring buffer of voxel references that new members are
@@ -26,6 +29,7 @@ struct SegmentMapParams {
   double min_overlap = 0.3;
   int min_new_segment_voxels = 20;
   int max_confidence = 8;
+  double merge_fraction = 0.4;  // > 0.5 never merges
 };
 
 class SegmentMap {
@@ -41,6 +45,9 @@ class SegmentMap {
   const std::vector<int>& frame_segments() const { return frame_segments_; }
   // Largest global id handed out so far.
   int max_segment_id() const { return int(segments_.size()) - 1; }
+  // The segment a (possibly merged) id lives on as.
+  int resolve(int segment) const;
+  int merges() const { return merges_; }
   // Voxel references currently in the segment's ring (stale ones included).
   int ring_size(int segment) const;
 
@@ -57,10 +64,13 @@ class SegmentMap {
   };
   Ring& ring(int segment);
   void assign(ObservationGrid& grid, int voxel, int segment);
+  void merge(ObservationGrid& grid, int kept, int gone);
 
   SegmentMapParams params_;
   std::vector<Ring> segments_{1};  // index = global id; 0 unused
   std::vector<int> frame_segments_;
+  std::vector<int> merged_into_;  // by id: the id it was merged into, 0 = none
+  int merges_ = 0;
 };
 
 }  // namespace glint::reflectance

@@ -91,6 +91,29 @@ TEST(SegmentMap, PropagatesTwoObjectsAcrossRenumberedFrames) {
   for (int v : distinct) EXPECT_EQ(scene.grid.segment(v), id);
 }
 
+TEST(SegmentMap, OneSurfaceSeenInTwoPiecesIsMerged) {
+  Scene scene;
+  SegmentMap segments;
+  for (int index = 0; index < 3; ++index) {
+    ImageF depth;
+    const auto& visible = scene.frame(index, 0.0, depth);
+    // Frame 0 splits the near wall at image column 20 into labels 1 and 2; later frames see it
+    // whole (label 1). The far wall is label 3 throughout.
+    Image<std::int32_t> labels(kCamera.width, kCamera.height, 1);
+    for (int y = 0; y < kCamera.height; ++y)
+      for (int x = 0; x < kCamera.width; ++x)
+        labels.at(x, y, 0) = depth.at(x, y, 0) > 1.2f ? 3 : (index == 0 && x >= 20 ? 2 : 1);
+    segments.update(scene.grid, visible, labels, false);
+  }
+  EXPECT_EQ(segments.merges(), 1);
+  EXPECT_EQ(segments.frame_segments().size(), 2u);
+  std::set<int> near_ids;
+  for (int v = 0; v < int(scene.grid.voxel_count()); ++v)
+    if (scene.grid.segment(v) > 0 && wall_of(scene.grid.position(v)) == 1)
+      near_ids.insert(scene.grid.segment(v));
+  EXPECT_EQ(near_ids.size(), 1u);
+}
+
 TEST(SegmentMap, DepthSegmentationSeparatesTheWallsAndStaysConsistent) {
   Scene scene;
   SegmentMap segments;
