@@ -6,7 +6,8 @@
 #   - with ground-truth and with glint's own segmentation, at 2 cm observation voxels;
 #   - with the modified (parabolic, lambda_d 0.1, lambda_l 0.3) and the unmodified
 #     (orthographic, lambda 1) HemiCNN, ground-truth segmentation;
-#   - at 1 cm observation voxels (Table 3 timings).
+#   - at 1 cm observation voxels (Table 3 timings);
+#   - "fast": 1 cm geometry voxels instead of 5 mm (a CPU budget option, not the paper's).
 # Reports: OUT/<scene>-<variant>/report.json; a summary table: OUT/summary.md.
 #   scripts/eval-reflectance.sh GLINT DATA [OUT] [SCENES] [FRAMES]
 set -euo pipefail
@@ -35,7 +36,8 @@ for scene in $SCENES; do
   run gtseg --gt-segmentation --model "$MODELS/hemicnn.json"
   run ownseg --model "$MODELS/hemicnn.json"
   run unmodified --gt-segmentation --model "$MODELS/hemicnn-unmodified.json"
-  run gtseg-1cm --gt-segmentation --model "$MODELS/hemicnn.json" --obs-voxel 0.01 --eval-every 0
+  run gtseg-1cm --gt-segmentation --model "$MODELS/hemicnn.json" --obs-voxel 0.01 --eval-every 10
+  run fast --gt-segmentation --model "$MODELS/hemicnn.json" --voxel 0.01 --eval-every 10
 done
 python3 "$(dirname "$0")/reflectance-summary.py" "$OUT" $SCENES > "$OUT/summary.md"
 echo "eval-reflectance: reports in $OUT, summary in $OUT/summary.md"

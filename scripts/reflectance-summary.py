@@ -54,7 +54,7 @@ def main():
               "| paper (bunnies, own pipeline) | " +
               " | ".join(str(PAPER_AVERAGE[q][0]) for q in QUANTITIES) + " | 27.61 |"]
     for scene in scenes:
-        for variant in ["gtseg", "ownseg", "unmodified"]:
+        for variant in ["gtseg", "ownseg", "unmodified", "gtseg-1cm", "fast"]:
             r = load(out, scene, variant)
             if r and r.get("evaluation"):
                 lines.append(averages_row(r, f"{scene} / {variant}"))
@@ -64,8 +64,10 @@ def main():
             r = load(out, scene, variant)
             if r and r.get("evaluation"):
                 lines += table1(r, f"{scene}, {variant}")
-    for grid, variant in [("2cm", "gtseg"), ("1cm", "gtseg-1cm")]:
-        lines += [f"## Per-stage ms per frame (median; mean in brackets), {grid} observation grid",
+    for grid, variant in [("2cm", "gtseg"), ("1cm", "gtseg-1cm"), ("2cm", "ownseg"),
+                          ("2cm", "fast")]:
+        lines += [f"## Per-stage ms per frame (median; mean in brackets), {grid} observation "
+                  f"grid, variant {variant}",
                   "", "| stage | " + " | ".join(scenes) + " |", "|---" * (len(scenes) + 1) + "|"]
         reports = {s: load(out, s, variant) for s in scenes}
         for stage in STAGES:

@@ -267,6 +267,11 @@ void register_reconstruct_command(CLI::App& app) {
   command->add_option("--views", options->views,
                       "TUM trajectory (camera-to-world) of extra poses to re-render the final "
                       "model from, into OUT/views/");
+  command
+      ->add_option("--albedo-every", params.albedo_refresh_frames,
+                   "Re-solve each visible voxel's albedo every N frames (staggered)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   command->add_option("--seed", params.specular.seed, "Seed of the voxel sampling")
       ->capture_default_str();
   command->add_option("--report", options->report,

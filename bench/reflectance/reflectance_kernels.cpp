@@ -62,13 +62,18 @@ void HemiImage(benchmark::State& state) {
 BENCHMARK(HemiImage)->Unit(benchmark::kMicrosecond);
 
 void InsertIntoFullVoxel(benchmark::State& state) {
-  auto slots = random_observations(30, 3);
+  const auto initial = random_observations(30, 3);
+  std::vector<Observation> slots(30);
+  std::vector<NearestObservation> nearest(30);
+  int count = 0;
+  for (const Observation& o : initial)
+    count = insert_observation(slots.data(), nearest.data(), count, 30, o);
   const auto incoming = random_observations(1024, 4);
   std::size_t next = 0;
   for (auto _ : state) {
     Observation added = incoming[next++ % incoming.size()];
     added.frame = std::uint32_t(100 + next);
-    benchmark::DoNotOptimize(insert_observation(slots.data(), 30, 30, added));
+    benchmark::DoNotOptimize(insert_observation(slots.data(), nearest.data(), count, 30, added));
   }
 }
 BENCHMARK(InsertIntoFullVoxel)->Unit(benchmark::kNanosecond);

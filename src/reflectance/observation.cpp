@@ -1,29 +1,66 @@
 #include "reflectance/observation.h"
 
 namespace glint::reflectance {
+namespace {
 
-int insert_observation(Observation* slots, int count, int capacity, const Observation& added) {
+// The nearest other observation of slot i among slots[0, count).
+NearestObservation nearest_of(const Observation* slots, int count, int i) {
+  NearestObservation best;
+  for (int j = 0; j < count; ++j) {
+    if (j == i) continue;
+    const float similarity = slots[i].direction.dot(slots[j].direction);
+    if (similarity > best.similarity) best = {similarity, std::uint8_t(j)};
+  }
+  return best;
+}
+
+// Stores `added` in slot r (a new slot when r == count) and updates every nearest entry;
+// `similarity[j]` = added . slots[j] for the other slots.
+void place(Observation* slots, NearestObservation* nearest, int count, int r,
+           const Observation& added, const float* similarity) {
+  slots[r] = added;
+  nearest[r] = {};
+  for (int j = 0; j < count; ++j) {
+    if (j == r) continue;
+    if (similarity[j] > nearest[r].similarity) nearest[r] = {similarity[j], std::uint8_t(j)};
+  }
+  for (int i = 0; i < count; ++i) {
+    if (i == r) continue;
+    if (nearest[i].slot == r && nearest[i].similarity > -2.0f)
+      nearest[i] = nearest_of(slots, count, i);  // its nearest was replaced
+    else if (similarity[i] > nearest[i].similarity)
+      nearest[i] = {similarity[i], std::uint8_t(r)};
+  }
+}
+
+}  // namespace
+
+int insert_observation(Observation* slots, NearestObservation* nearest, int count, int capacity,
+                       const Observation& added) {
   if (capacity <= 0) return 0;
+  float similarity[256];
+  for (int j = 0; j < count; ++j) similarity[j] = added.direction.dot(slots[j].direction);
   if (count < capacity) {
-    slots[count] = added;
+    place(slots, nearest, count + 1, count, added, similarity);
     return count + 1;
   }
-  // Slot index `capacity` stands for the new observation.
-  auto at = [&](int i) -> const Observation& { return i == capacity ? added : slots[i]; };
-  int best_a = 0, best_b = 1;
-  float best_similarity = -2.0f;
-  for (int a = 0; a <= capacity; ++a)
-    for (int b = a + 1; b <= capacity; ++b) {
-      const float similarity = at(a).direction.dot(at(b).direction);
-      if (similarity > best_similarity) {
-        best_similarity = similarity;
-        best_a = a;
-        best_b = b;
-      }
-    }
-  // best_a < best_b; the new observation (index capacity) is never older than a stored one.
-  const int dropped = at(best_a).frame <= at(best_b).frame ? best_a : best_b;
-  if (dropped != capacity) slots[dropped] = added;
+  // The most similar stored pair, and the stored observation most similar to the new one.
+  int first = 0;
+  for (int i = 1; i < capacity; ++i)
+    if (nearest[i].similarity > nearest[first].similarity) first = i;
+  int closest_to_new = 0;
+  for (int j = 1; j < capacity; ++j)
+    if (similarity[j] > similarity[closest_to_new]) closest_to_new = j;
+  int dropped;
+  if (similarity[closest_to_new] > nearest[first].similarity) {
+    // The pair (new, closest_to_new): the older goes, the stored one unless it is newer.
+    if (added.frame < slots[closest_to_new].frame) return capacity;
+    dropped = closest_to_new;
+  } else {
+    const int second = nearest[first].slot;
+    dropped = slots[first].frame <= slots[second].frame ? first : second;
+  }
+  place(slots, nearest, capacity, dropped, added, similarity);
   return capacity;
 }
 

@@ -15,10 +15,20 @@ struct Observation {
   std::uint32_t frame = 0;                               // frame it was observed in
 };
 
-// Adds `added` to the `count` observations in slots[0, capacity) and returns the new count.
-// When the voxel is full, of the most similar pair (largest direction dot product over all
-// pairs including the new one) the older observation is dropped: newer ones were taken with
-// better-converged geometry. O(capacity^2) when full; no allocation.
-int insert_observation(Observation* slots, int count, int capacity, const Observation& added);
+// For each stored observation, its most similar other stored observation: the slot and their
+// direction dot product (-2 while it is alone). Kept up to date by insert_observation, so the
+// most similar pair of a full voxel is found in O(capacity) instead of O(capacity^2).
+struct NearestObservation {
+  float similarity = -2.0f;
+  std::uint8_t slot = 0;
+};
+
+// Adds `added` to the `count` observations in slots[0, capacity) (capacity <= 255) and returns
+// the new count; `nearest` holds one entry per slot. When the voxel is full, of the most similar
+// pair (largest direction dot product over all pairs including the new one) the older
+// observation is dropped: newer ones were taken with better-converged geometry. O(capacity)
+// plus O(capacity) for each stored observation whose nearest one was dropped; no allocation.
+int insert_observation(Observation* slots, NearestObservation* nearest, int count, int capacity,
+                       const Observation& added);
 
 }  // namespace glint::reflectance

@@ -47,6 +47,7 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
       voxels_per_block_(side_ * side_ * side_),
       hash_(std::max<std::size_t>(1, params.voxel_capacity / std::size_t(side_ * side_ * side_))),
       observations_(zeroed_pool<Observation>(1)),
+      nearest_(zeroed_pool<NearestObservation>(1)),
       observation_count_(zeroed_pool<std::uint8_t>(1)),
       position_(zeroed_pool<Eigen::Vector3f>(1)),
       normal_(zeroed_pool<Eigen::Vector3f>(1)),
@@ -62,6 +63,7 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
     throw Error("observation grid", "allocation_stride_px", "must be >= 1");
   const std::size_t voxels = hash_.capacity() * voxels_per_block_;
   observations_ = zeroed_pool<Observation>(voxels * params.observations_per_voxel);
+  nearest_ = zeroed_pool<NearestObservation>(voxels * params.observations_per_voxel);
   observation_count_ = zeroed_pool<std::uint8_t>(voxels);
   position_ = zeroed_pool<Eigen::Vector3f>(voxels);
   normal_ = zeroed_pool<Eigen::Vector3f>(voxels);
@@ -216,9 +218,10 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
           inverse_exposure;
       observation.direction = direction;
       observation.frame = std::uint32_t(frame);
-      Observation* slots = observations_.get() + std::size_t(v) * capacity;
-      observation_count_[v] =
-          std::uint8_t(insert_observation(slots, observation_count_[v], capacity, observation));
+      const std::size_t first_slot = std::size_t(v) * capacity;
+      observation_count_[v] = std::uint8_t(
+          insert_observation(observations_.get() + first_slot, nearest_.get() + first_slot,
+                             observation_count_[v], capacity, observation));
       visible_[slot * voxels_per_block_ + local] = {v, y * width + x};
     }
   });

@@ -121,6 +121,7 @@ class ObservationGrid {
 
   // Structure-of-arrays voxel pools (zero-initialised, committed on first touch).
   Pool<Observation> observations_;
+  Pool<NearestObservation> nearest_;  // parallel to observations_
   Pool<std::uint8_t> observation_count_;
   Pool<Eigen::Vector3f> position_, normal_, refined_kd_;
   Pool<int> geometry_frame_;  // frame of the last surface refresh + 1 (0 = never tried)

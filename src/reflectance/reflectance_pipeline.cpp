@@ -19,6 +19,8 @@ ReflectancePipeline::ReflectancePipeline(const Intrinsics& intrinsics,
       segment_map_(params.segments),
       specular_(network, params.specular),
       lights_(std::move(lights)) {
+  if (params.albedo_refresh_frames < 1)
+    throw Error("reflectance pipeline", "albedo_refresh_frames", "must be >= 1");
   if (lights_.empty())
     throw Error("reflectance pipeline", "lights",
                 "needs at least one light (estimate them with `glint lights`)");
@@ -28,6 +30,7 @@ void ReflectancePipeline::refine_albedo_of_visible() {
   const std::vector<VisibleVoxel>& visible = grid_.visible();
   parallel_for(visible.size(), [&](std::size_t i) {
     const int v = visible[i].voxel;
+    if (grid_.has_refined_kd(v) && (v + frame_) % params_.albedo_refresh_frames != 0) return;
     const SegmentMaterial* material = specular_.material(grid_.segment(v));
     if (!material) return;
     const auto kd =

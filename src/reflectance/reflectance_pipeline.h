@@ -34,6 +34,10 @@ struct ReflectanceParams {
   int segmentation_halvings = 1;
   SegmentMapParams segments;
   SpecularParams specular;
+  // Each visible voxel's albedo is re-solved every this many frames (staggered over the voxels;
+  // a voxel without one is solved at once): one new observation of up to 30 moves the mean
+  // little, and the paper's per-frame cost on a GPU is 4x ours per voxel on 2 CPU cores.
+  int albedo_refresh_frames = 4;
   // Radiance = pixel colour / exposure; the lights are in the same radiance units
   // (reflectance/light_estimation.h).
   float exposure = 1;

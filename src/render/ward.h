@@ -31,8 +31,10 @@ inline float ward_specular_lobe(const Eigen::Vector3f& n, const Eigen::Vector3f&
   const Eigen::Vector3f h = wi + wo;  // unnormalised half vector
   const float cos_h2 = std::min(1.0f, n.dot(h) * n.dot(h) / h.squaredNorm());
   if (cos_h2 <= 0.0f) return 0.0f;
-  const float tan_h2 = (1.0f - cos_h2) / cos_h2;                             // tan^2(theta_h)
-  const float gamma = -tan_h2 / (a * a);                                     // eq. (4)
+  const float tan_h2 = (1.0f - cos_h2) / cos_h2;  // tan^2(theta_h)
+  const float gamma = -tan_h2 / (a * a);          // eq. (4)
+  // exp(-40) / N < 1e-8 even at alpha = kMinWardAlpha and grazing cosines: skip exp and sqrt.
+  if (gamma < -40.0f) return 0.0f;
   const float norm = 4.0f * float(M_PI) * a * a * std::sqrt(cos_i * cos_o);  // eq. (3)
   return std::exp(gamma) / norm;
 }

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <vector>
 
 namespace glint::reflectance {
@@ -16,26 +18,74 @@ Observation seen_from(float theta, float phi, std::uint32_t frame) {
   return o;
 }
 
+// A voxel's slots with their nearest-neighbour bookkeeping.
+struct Voxel {
+  explicit Voxel(int capacity) : slots(capacity), nearest(capacity), capacity(capacity) {}
+  void insert(const Observation& o) {
+    count = insert_observation(slots.data(), nearest.data(), count, capacity, o);
+  }
+  std::vector<Observation> slots;
+  std::vector<NearestObservation> nearest;
+  int capacity, count = 0;
+};
+
+// The definition, by brute force over all pairs including the new one (O(capacity^2)).
+int reference_insert(std::vector<Observation>& slots, int count, int capacity,
+                     const Observation& added) {
+  if (count < capacity) {
+    slots[count] = added;
+    return count + 1;
+  }
+  auto at = [&](int i) -> const Observation& { return i == capacity ? added : slots[i]; };
+  int best_a = 0, best_b = 1;
+  float best = -2.0f;
+  for (int a = 0; a <= capacity; ++a)
+    for (int b = a + 1; b <= capacity; ++b)
+      if (at(a).direction.dot(at(b).direction) > best)
+        best = at(a).direction.dot(at(b).direction), best_a = a, best_b = b;
+  const int dropped = at(best_a).frame <= at(best_b).frame ? best_a : best_b;
+  if (dropped != capacity) slots[dropped] = added;
+  return capacity;
+}
+
 TEST(Observations, FillUpToCapacityThenStayFull) {
-  std::vector<Observation> slots(4);
-  int count = 0;
-  for (std::uint32_t f = 0; f < 10; ++f)
-    count = insert_observation(slots.data(), count, 4, seen_from(0.1f * f, 0.7f * f, f));
-  EXPECT_EQ(count, 4);
-  EXPECT_EQ(insert_observation(slots.data(), 0, 0, seen_from(0, 0, 0)), 0);
+  Voxel voxel(4);
+  for (std::uint32_t f = 0; f < 10; ++f) voxel.insert(seen_from(0.1f * f, 0.7f * f, f));
+  EXPECT_EQ(voxel.count, 4);
+  Voxel none(0);
+  none.insert(seen_from(0, 0, 0));
+  EXPECT_EQ(none.count, 0);
+}
+
+TEST(Observations, KeepsTheSameObservationsAsTheBruteForceDefinition) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> theta(0.0f, 1.5f), phi(0.0f, 6.283f);
+  for (int capacity : {2, 5, 30}) {
+    Voxel voxel(capacity);
+    std::vector<Observation> reference(capacity);
+    int reference_count = 0;
+    for (std::uint32_t f = 0; f < 400; ++f) {
+      const Observation o = seen_from(theta(random), phi(random), f);
+      voxel.insert(o);
+      reference_count = reference_insert(reference, reference_count, capacity, o);
+      ASSERT_EQ(voxel.count, reference_count);
+      for (int k = 0; k < capacity && k < voxel.count; ++k)
+        ASSERT_EQ(voxel.slots[k].frame, reference[k].frame)
+            << "capacity " << capacity << " frame " << f;
+    }
+  }
 }
 
 TEST(Observations, OverflowDropsTheOlderOfTheMostSimilarPair) {
-  std::vector<Observation> slots(3);
-  int count = 0;
-  count = insert_observation(slots.data(), count, 3, seen_from(0.0f, 0.0f, 0));   // top
-  count = insert_observation(slots.data(), count, 3, seen_from(1.2f, 0.0f, 1));   // +x grazing
-  count = insert_observation(slots.data(), count, 3, seen_from(1.2f, 3.14f, 2));  // -x grazing
+  Voxel voxel(3);
+  voxel.insert(seen_from(0.0f, 0.0f, 0));   // top
+  voxel.insert(seen_from(1.2f, 0.0f, 1));   // +x grazing
+  voxel.insert(seen_from(1.2f, 3.14f, 2));  // -x grazing
   // Nearly the +x direction again: the pair (frame 1, new) is the most similar; frame 1 goes.
-  count = insert_observation(slots.data(), count, 3, seen_from(1.15f, 0.05f, 3));
-  ASSERT_EQ(count, 3);
+  voxel.insert(seen_from(1.15f, 0.05f, 3));
+  ASSERT_EQ(voxel.count, 3);
   std::vector<std::uint32_t> frames;
-  for (const Observation& o : slots) frames.push_back(o.frame);
+  for (const Observation& o : voxel.slots) frames.push_back(o.frame);
   std::sort(frames.begin(), frames.end());
   EXPECT_EQ(frames, (std::vector<std::uint32_t>{0, 2, 3}));
 }
@@ -43,17 +93,12 @@ TEST(Observations, OverflowDropsTheOlderOfTheMostSimilarPair) {
 TEST(Observations, RepeatedViewsKeepTheHemisphereCovered) {
   // 30 slots, then 300 observations all from nearly the same direction plus a few others:
   // the few distinct directions must survive (uniform coverage, not recency).
-  const int capacity = 30;
-  std::vector<Observation> slots(capacity);
-  int count = 0;
+  Voxel voxel(30);
   std::uint32_t frame = 0;
-  for (int i = 0; i < 5; ++i)
-    count = insert_observation(slots.data(), count, capacity, seen_from(1.0f, 1.25f * i, frame++));
-  for (int i = 0; i < 300; ++i)
-    count = insert_observation(slots.data(), count, capacity,
-                               seen_from(0.05f + 0.0001f * i, 0.0f, frame++));
+  for (int i = 0; i < 5; ++i) voxel.insert(seen_from(1.0f, 1.25f * i, frame++));
+  for (int i = 0; i < 300; ++i) voxel.insert(seen_from(0.05f + 0.0001f * i, 0.0f, frame++));
   int distinct = 0;
-  for (int k = 0; k < count; ++k) distinct += slots[k].frame < 5;
+  for (int k = 0; k < voxel.count; ++k) distinct += voxel.slots[k].frame < 5;
   EXPECT_EQ(distinct, 5);
 }
 
