@@ -28,6 +28,7 @@ struct SynthCommandOptions {
   std::uint64_t seed = 1;
   std::string data_dir = render::default_data_dir();
   int sequences = render::TrainingSetParams{}.sequences;
+  std::vector<std::string> shapes;  // training: empty = all
   bool no_ground_truth = false;
   bool no_shadows = false;
   bool preview = false;
@@ -52,6 +53,7 @@ nlohmann::json run_training_set(const SynthCommandOptions& options) {
   params.seed = options.seed;
   params.data_dir = options.data_dir;
   params.ground_truth = !options.no_ground_truth;
+  params.shapes = options.shapes;
   nlohmann::json report = render::training_set_parameters_json(params);
   if (options.preview) {
     report["render_ms"] =
@@ -161,6 +163,12 @@ void register_synth_command(CLI::App& app) {
   command->add_option("--sequences", options->sequences, "training: number of sequences")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  command
+      ->add_option("--shapes", options->shapes,
+                   "training: shapes to draw from, comma-separated (default all: sphere, box and "
+                   "the meshes of DATA/meshes)")
+      ->delimiter(',')
+      ->check(CLI::IsMember(render::training_shape_names()));
   command->add_flag("--no-gt", options->no_ground_truth, "Do not write the gt/ maps");
   command->add_flag("--no-shadows", options->no_shadows, "Scenes: no shadow rays");
   command->add_flag("--preview", options->preview,
