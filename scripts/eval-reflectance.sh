@@ -30,6 +30,7 @@ for scene in $SCENES; do
   run() {  # run NAME ARGS...
     local name=$1
     shift
+    [[ -f "$OUT/$scene-$name.json" ]] && return 0  # done in an earlier run
     "$GLINT" --quiet reconstruct "$seq" --lights "$OUT/lights-$scene.json" --gt-poses \
       -o "$OUT/$scene-$name" --report "$OUT/$scene-$name.json" "$@" \
       > "$OUT/$scene-$name.txt"
