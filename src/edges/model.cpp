@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "io/json_fields.h"
 #include "io/json_report.h"
 
 namespace glint::edges {
@@ -49,77 +50,6 @@ void apply_leaky_relu(float* rows, int row_count, std::size_t count, float slope
     float* row = rows + static_cast<std::size_t>(r) * kBatch;
     for (std::size_t b = 0; b < count; ++b) row[b] = row[b] > 0.0f ? row[b] : slope * row[b];
   }
-}
-
-// ---- model file reading: every access names the file and the key on failure.
-
-class FileReader {
- public:
-  explicit FileReader(std::string path) : path_(std::move(path)) {}
-
-  [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
-    throw Error(path_, key, reason);
-  }
-
-  const nlohmann::json& member(const nlohmann::json& object, const std::string& key,
-                               const std::string& where) const {
-    const auto it = object.find(key);
-    if (it == object.end()) fail(where, "missing key");
-    return *it;
-  }
-
-  int integer(const nlohmann::json& object, const std::string& key) const {
-    const nlohmann::json& value = member(object, key, key);
-    if (!value.is_number_integer()) fail(key, "expected an integer");
-    return value.get<int>();
-  }
-
-  float finite_float(const nlohmann::json& value, const std::string& where) const {
-    if (!value.is_number()) fail(where, "expected a number, got " + std::string(value.type_name()));
-    // Doubles below 2^128 - 2^103 (FLT_MAX plus half an ulp) round to a finite float.
-    static const double float_limit = std::ldexp(1.0, 128) - std::ldexp(1.0, 103);
-    const double result = value.get<double>();
-    if (!(std::fabs(result) < float_limit)) fail(where, "not a finite float");
-    return static_cast<float>(result);
-  }
-
-  std::vector<float> floats(const nlohmann::json& object, const std::string& key,
-                            std::size_t expected_size, const std::string& where) const {
-    const nlohmann::json& array = member(object, key, where);
-    if (!array.is_array()) fail(where, "expected an array of numbers");
-    if (array.size() != expected_size)
-      fail(where, fmt::format("expected {} values, found {}", expected_size, array.size()));
-    std::vector<float> values(expected_size);
-    for (std::size_t i = 0; i < expected_size; ++i)
-      values[i] = finite_float(array[i], fmt::format("{}[{}]", where, i));
-    return values;
-  }
-
-  std::vector<int> integers(const nlohmann::json& object, const std::string& key) const {
-    const nlohmann::json& array = member(object, key, key);
-    if (!array.is_array()) fail(key, "expected an array of integers");
-    std::vector<int> values;
-    for (const auto& value : array) {
-      if (!value.is_number_integer()) fail(key, "expected an array of integers");
-      values.push_back(value.get<int>());
-    }
-    return values;
-  }
-
- private:
-  std::string path_;
-};
-
-// A float as the double closest to its 9-significant-digit decimal: the JSON writer prints it
-// with at most 9 digits, and reading it back gives the same float.
-double nine_digits(float value) {
-  return std::strtod(fmt::format("{:.9g}", value).c_str(), nullptr);
-}
-
-nlohmann::json float_array(const std::vector<float>& values) {
-  nlohmann::json array = nlohmann::json::array();
-  for (float v : values) array.push_back(nine_digits(v));
-  return array;
 }
 
 }  // namespace
@@ -215,8 +145,8 @@ nlohmann::json Model::to_json() const {
     layer_array.push_back({{"name", layer.name},
                            {"inputs", layer.inputs},
                            {"outputs", layer.outputs},
-                           {"weights", float_array(layer.weights)},
-                           {"bias", float_array(layer.bias)}});
+                           {"weights", io::exact_float_array(layer.weights)},
+                           {"bias", io::exact_float_array(layer.bias)}});
   return {{"format", kFormatName},
           {"version", kFormatVersion},
           {"classes", class_names(config.classes)},
@@ -225,10 +155,10 @@ nlohmann::json Model::to_json() const {
           {"fusion_width", config.fusion_width},
           {"hidden", config.hidden},
           {"hidden_layers", config.hidden_layers},
-          {"leaky_slope", nine_digits(config.leaky_slope)},
+          {"leaky_slope", io::exact_float(config.leaky_slope)},
           {"parameter_count", parameter_count()},
-          {"input_mean", float_array(input_mean)},
-          {"input_std", float_array(input_std)},
+          {"input_mean", io::exact_float_array(input_mean)},
+          {"input_std", io::exact_float_array(input_std)},
           {"layers", layer_array},
           {"training", training_info.is_null() ? nlohmann::json::object() : training_info}};
 }
@@ -236,18 +166,18 @@ nlohmann::json Model::to_json() const {
 void Model::save(const std::string& path) const { io::write_json(path, to_json()); }
 
 Model Model::load(const std::string& path) {
-  const FileReader reader(path);
+  const io::JsonFields reader(path);
   const nlohmann::json root = io::read_json(path);
   if (!root.is_object()) reader.fail("", "expected a JSON object at the top level");
 
-  const nlohmann::json& format = reader.member(root, "format", "format");
+  const nlohmann::json& format = reader.member(root, "format");
   if (!format.is_string() || format.get<std::string>() != kFormatName)
     reader.fail("format", fmt::format("expected \"{}\"", kFormatName));
   if (const int version = reader.integer(root, "version"); version != kFormatVersion)
     reader.fail("version", fmt::format("unsupported version {} (this glint reads {})", version,
                                        kFormatVersion));
 
-  const nlohmann::json& classes = reader.member(root, "classes", "classes");
+  const nlohmann::json& classes = reader.member(root, "classes");
   if (!classes.is_array() || (classes.size() != 2 && classes.size() != 3))
     reader.fail("classes", "expected a list of 2 or 3 class names");
   const int class_count = static_cast<int>(classes.size());
@@ -266,8 +196,7 @@ Model Model::load(const std::string& path) {
   config.fusion_width = reader.integer(root, "fusion_width");
   config.hidden = reader.integer(root, "hidden");
   config.hidden_layers = reader.integer(root, "hidden_layers");
-  config.leaky_slope =
-      reader.finite_float(reader.member(root, "leaky_slope", "leaky_slope"), "leaky_slope");
+  config.leaky_slope = reader.finite_float(reader.member(root, "leaky_slope"), "leaky_slope");
   try {
     check_config(config);
   } catch (const Error& e) {
@@ -276,13 +205,13 @@ Model Model::load(const std::string& path) {
 
   Model model(config);
   const std::size_t columns = config.scales.size() * kFeaturesPerScale;
-  model.input_mean = reader.floats(root, "input_mean", columns, "input_mean");
-  model.input_std = reader.floats(root, "input_std", columns, "input_std");
+  model.input_mean = reader.floats(root, "input_mean", columns);
+  model.input_std = reader.floats(root, "input_std", columns);
   for (std::size_t c = 0; c < columns; ++c)
     if (!(model.input_std[c] >= kMinInputStd))
       reader.fail(fmt::format("input_std[{}]", c), fmt::format("must be >= {}", kMinInputStd));
 
-  const nlohmann::json& layer_array = reader.member(root, "layers", "layers");
+  const nlohmann::json& layer_array = reader.member(root, "layers");
   if (!layer_array.is_array() || layer_array.size() != model.layers.size())
     reader.fail("layers", fmt::format("expected an array of {} layers", model.layers.size()));
   for (std::size_t l = 0; l < model.layers.size(); ++l) {
@@ -290,19 +219,19 @@ Model Model::load(const std::string& path) {
     const nlohmann::json& entry = layer_array[l];
     const std::string where = fmt::format("layers[{}]", l);
     if (!entry.is_object()) reader.fail(where, "expected an object");
-    const nlohmann::json& name = reader.member(entry, "name", where + ".name");
+    const nlohmann::json& name = reader.member(entry, "name", where);
     if (!name.is_string() || name.get<std::string>() != layer.name)
       reader.fail(where + ".name", fmt::format("expected \"{}\"", layer.name));
-    const nlohmann::json& inputs = reader.member(entry, "inputs", where + ".inputs");
-    const nlohmann::json& outputs = reader.member(entry, "outputs", where + ".outputs");
+    const nlohmann::json& inputs = reader.member(entry, "inputs", where);
+    const nlohmann::json& outputs = reader.member(entry, "outputs", where);
     if (inputs != layer.inputs || outputs != layer.outputs)
       reader.fail(where,
                   fmt::format("the config implies a {} x {} layer", layer.outputs, layer.inputs));
-    layer.weights = reader.floats(entry, "weights", layer.weights.size(), where + ".weights");
-    layer.bias = reader.floats(entry, "bias", layer.bias.size(), where + ".bias");
+    layer.weights = reader.floats(entry, "weights", layer.weights.size(), where);
+    layer.bias = reader.floats(entry, "bias", layer.bias.size(), where);
   }
 
-  const nlohmann::json& count = reader.member(root, "parameter_count", "parameter_count");
+  const nlohmann::json& count = reader.member(root, "parameter_count");
   if (!count.is_number_unsigned() || count.get<std::size_t>() != model.parameter_count())
     reader.fail("parameter_count",
                 fmt::format("the layers hold {} parameters", model.parameter_count()));

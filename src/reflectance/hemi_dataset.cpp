@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "io/json_fields.h"
 #include "io/json_report.h"
 #include "io/npy.h"
 
@@ -45,54 +46,6 @@ void check_size(int size, const std::string& where) {
                 fmt::format("hemi-image size {} is outside [{}, {}]", size, kMinHemiImageSize,
                             kMaxHemiImageSize));
 }
-
-// ---- index.json reading: every failure names the file and the key.
-
-class IndexReader {
- public:
-  explicit IndexReader(std::string path) : path_(std::move(path)) {}
-
-  [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
-    throw Error(path_, key, reason);
-  }
-
-  const nlohmann::json& member(const nlohmann::json& object, const std::string& key,
-                               const std::string& where) const {
-    if (!object.is_object()) fail(where, "expected an object");
-    const auto it = object.find(key);
-    if (it == object.end()) fail(where.empty() ? key : where + "." + key, "missing key");
-    return *it;
-  }
-
-  float number(const nlohmann::json& value, const std::string& where) const {
-    if (!value.is_number()) fail(where, "expected a number");
-    const double result = value.get<double>();
-    if (!std::isfinite(result) || std::fabs(result) > 1e30) fail(where, "not a finite float");
-    return static_cast<float>(result);
-  }
-
-  std::vector<float> numbers(const nlohmann::json& object, const std::string& key,
-                             std::size_t count, const std::string& where) const {
-    const nlohmann::json& array = member(object, key, where);
-    const std::string name = where + "." + key;
-    if (!array.is_array() || array.size() != count)
-      fail(name, fmt::format("expected an array of {} numbers", count));
-    std::vector<float> values(count);
-    for (std::size_t i = 0; i < count; ++i)
-      values[i] = number(array[i], fmt::format("{}[{}]", name, i));
-    return values;
-  }
-
-  std::string string(const nlohmann::json& object, const std::string& key,
-                     const std::string& where) const {
-    const nlohmann::json& value = member(object, key, where);
-    if (!value.is_string()) fail(where.empty() ? key : where + "." + key, "expected a string");
-    return value.get<std::string>();
-  }
-
- private:
-  std::string path_;
-};
 
 // Reads seq file `path`, expecting [M, 3, size, size] finite floats.
 void read_sequence_images(const std::string& path, int size, HemiSequence& sequence) {
@@ -148,7 +101,7 @@ HemiDataset read_hemi_dataset(const std::string& directory) {
   const std::string index_path = (folder / "index.json").string();
   if (!std::filesystem::is_regular_file(index_path))
     throw Error(index_path, "", "missing: not a HemiCNN dataset folder (no index.json)");
-  const IndexReader reader(index_path);
+  const io::JsonFields reader(index_path);
   const nlohmann::json root = io::read_json(index_path);
   if (!root.is_object()) reader.fail("", "expected a JSON object at the top level");
   if (reader.string(root, "format", "") != kFormatName)
@@ -178,13 +131,14 @@ HemiDataset read_hemi_dataset(const std::string& directory) {
     if (sequence.file.empty() || std::filesystem::path(sequence.file).has_parent_path())
       reader.fail(where + ".file", "expected a file name inside the dataset folder");
     sequence.source = reader.string(entry, "source", where);
-    const std::vector<float> kd = reader.numbers(entry, "kd", 3, where);
-    const std::vector<float> ks = reader.numbers(entry, "ks", 3, where);
+    const std::vector<float> kd = reader.floats(entry, "kd", 3, where);
+    const std::vector<float> ks = reader.floats(entry, "ks", 3, where);
     sequence.material.kd = Eigen::Vector3f(kd[0], kd[1], kd[2]);
     sequence.material.ks = Eigen::Vector3f(ks[0], ks[1], ks[2]);
-    sequence.material.alpha = reader.number(reader.member(entry, "alpha", where), where + ".alpha");
+    sequence.material.alpha =
+        reader.finite_float(reader.member(entry, "alpha", where), where + ".alpha");
     check_material(sequence.material, index_path, where);
-    const std::vector<float> target = reader.numbers(entry, "target", 7, where);
+    const std::vector<float> target = reader.floats(entry, "target", 7, where);
     sequence.target.lab = Eigen::Vector3f(target[0], target[1], target[2]);
     sequence.target.c = Eigen::Vector3f(target[3], target[4], target[5]);
     sequence.target.d = target[6];

@@ -10,6 +10,7 @@
 #include <cstring>
 
 #include "core/error.h"
+#include "io/json_fields.h"
 #include "io/json_report.h"
 #include "reflectance/hemi_dataset.h"
 
@@ -125,74 +126,6 @@ void apply_dense(const HemiCnnLayer& layer, const float* __restrict input,
   }
 }
 
-// ---- model file reading: every failure names the file and the key.
-
-class ModelReader {
- public:
-  explicit ModelReader(std::string path) : path_(std::move(path)) {}
-
-  [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
-    throw Error(path_, key, reason);
-  }
-
-  const nlohmann::json& member(const nlohmann::json& object, const std::string& key,
-                               const std::string& where) const {
-    if (!object.is_object()) fail(where, "expected an object");
-    const auto it = object.find(key);
-    if (it == object.end()) fail(where.empty() ? key : where + "." + key, "missing key");
-    return *it;
-  }
-
-  int integer(const nlohmann::json& object, const std::string& key,
-              const std::string& where = "") const {
-    const nlohmann::json& value = member(object, key, where);
-    if (!value.is_number_integer())
-      fail(where.empty() ? key : where + "." + key, "expected an integer");
-    return value.get<int>();
-  }
-
-  float finite_float(const nlohmann::json& value, const std::string& where) const {
-    if (!value.is_number()) fail(where, "expected a number, got " + std::string(value.type_name()));
-    // Doubles below 2^128 - 2^103 (FLT_MAX plus half an ulp) round to a finite float.
-    static const double float_limit = std::ldexp(1.0, 128) - std::ldexp(1.0, 103);
-    const double result = value.get<double>();
-    if (!(std::fabs(result) < float_limit)) fail(where, "not a finite float");
-    return static_cast<float>(result);
-  }
-
-  std::vector<float> floats(const nlohmann::json& object, const std::string& key,
-                            std::size_t expected_size, const std::string& where = "") const {
-    const std::string name = where.empty() ? key : where + "." + key;
-    const nlohmann::json& array = member(object, key, where);
-    if (!array.is_array()) fail(name, "expected an array of numbers");
-    if (array.size() != expected_size)
-      fail(name, fmt::format("expected {} values, found {}", expected_size, array.size()));
-    std::vector<float> values(expected_size);
-    for (std::size_t i = 0; i < expected_size; ++i)
-      values[i] = finite_float(array[i], fmt::format("{}[{}]", name, i));
-    return values;
-  }
-
- private:
-  std::string path_;
-};
-
-// A float as the double closest to its 9-significant-digit decimal: the JSON writer prints it
-// with at most 9 digits, and reading it back gives the same float.
-double nine_digits(float value) {
-  return std::strtod(fmt::format("{:.9g}", value).c_str(), nullptr);
-}
-
-nlohmann::json float_array(const float* values, std::size_t count) {
-  nlohmann::json array = nlohmann::json::array();
-  for (std::size_t i = 0; i < count; ++i) array.push_back(nine_digits(values[i]));
-  return array;
-}
-
-nlohmann::json float_array(const std::vector<float>& values) {
-  return float_array(values.data(), values.size());
-}
-
 }  // namespace
 
 void check_config(const HemiCnnConfig& config) {
@@ -298,8 +231,8 @@ nlohmann::json HemiCnn::to_json() const {
                            {"stride", layer.stride},
                            {"inputs", layer.inputs},
                            {"outputs", layer.outputs},
-                           {"weights", float_array(layer.weights)},
-                           {"bias", float_array(layer.bias)}});
+                           {"weights", io::exact_float_array(layer.weights)},
+                           {"bias", io::exact_float_array(layer.bias)}});
   return {
       {"format", kFormatName},
       {"version", kFormatVersion},
@@ -308,15 +241,15 @@ nlohmann::json HemiCnn::to_json() const {
       {"conv_channels", config.conv_channels},
       {"branch_features", config.branch_features},
       {"head_hidden", config.head_hidden},
-      {"leaky_slope", nine_digits(config.leaky_slope)},
+      {"leaky_slope", io::exact_float(config.leaky_slope)},
       {"weight_layout", "conv [ky][kx][in][out], dense [in][out]; flatten order (y, x, channel)"},
       {"parameter_count", parameter_count()},
       {"input_transform", "log1p(max(radiance, 0))"},
-      {"input_mean", float_array(input_mean, 3)},
-      {"input_std", float_array(input_std, 3)},
+      {"input_mean", io::exact_float_array(input_mean, 3)},
+      {"input_std", io::exact_float_array(input_std, 3)},
       {"targets", kTargetNames},
-      {"target_mean", float_array(target_mean, kTargets)},
-      {"target_std", float_array(target_std, kTargets)},
+      {"target_mean", io::exact_float_array(target_mean, kTargets)},
+      {"target_std", io::exact_float_array(target_std, kTargets)},
       {"layers", layer_array},
       {"training", training_info.is_null() ? nlohmann::json::object() : training_info}};
 }
@@ -324,7 +257,7 @@ nlohmann::json HemiCnn::to_json() const {
 void HemiCnn::save(const std::string& path) const { io::write_json(path, to_json()); }
 
 HemiCnn HemiCnn::load(const std::string& path) {
-  const ModelReader reader(path);
+  const io::JsonFields reader(path);
   const nlohmann::json root = io::read_json(path);
   if (!root.is_object()) reader.fail("", "expected a JSON object at the top level");
 
