@@ -46,7 +46,6 @@ struct ReconstructOptions {
   bool ground_truth_segmentation = false;
   int evaluate_every = 5;
   int render_every = 0;  // 0: only the last frame
-  std::size_t observation_voxels = 0;  // 0: scaled with the observation voxel
   std::string views;     // TUM trajectory of extra poses to re-render at the end
   reflectance::ReflectanceParams params;
 };
@@ -95,13 +94,6 @@ void run_reconstruct(ReconstructOptions options) {
   const bool has_truth = reflectance::has_ground_truth_maps(sequence);
   if (options.ground_truth_segmentation && !has_truth)
     throw Error(options.sequence, "--gt-segmentation", "the sequence has no gt/segment maps");
-  // A surface holds (0.02 / voxel)^2 times as many voxels as at 2 cm; the finer grid also
-  // allocates more partly empty blocks, hence the factor 2 below 2 cm.
-  const double finer = 0.02 / options.params.observations.voxel_size_m;
-  options.params.observations.voxel_capacity =
-      options.observation_voxels
-          ? options.observation_voxels
-          : std::size_t(double(1u << 20) * std::max(1.0, 2.0 * finer * finer));
   options.params.exposure =
       options.exposure.value_or(reflectance::capture_exposure(options.sequence));
   const reflectance::LightEstimate lights = load_lights(options);
@@ -253,7 +245,7 @@ void register_reconstruct_command(CLI::App& app) {
                    "Observation grid voxel, metres (paper: 0.02 or 0.01)")
       ->capture_default_str();
   command
-      ->add_option("--obs-voxels", options->observation_voxels,
+      ->add_option("--obs-voxels", params.observations.voxel_capacity,
                    "Observation voxel pool (about 1.1 KB each, committed as used); default 2^20 "
                    "at 2 cm, 2 x (0.02 / obs-voxel)^2 times that below")
       ->check(CLI::PositiveNumber);

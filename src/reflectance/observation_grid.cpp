@@ -2,6 +2,7 @@
 
 #include <tbb/enumerable_thread_specific.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -39,13 +40,19 @@ int block_side(const ObservationGridParams& params) {
   return side;
 }
 
+std::size_t voxel_capacity(const ObservationGridParams& params) {
+  if (params.voxel_capacity > 0) return params.voxel_capacity;
+  const double finer = 0.02 / params.voxel_size_m;
+  return std::size_t(double(1u << 20) * std::max(1.0, 2.0 * finer * finer));
+}
+
 }  // namespace
 
 ObservationGrid::ObservationGrid(const ObservationGridParams& params)
     : params_(params),
       side_(block_side(params)),
       voxels_per_block_(side_ * side_ * side_),
-      hash_(std::max<std::size_t>(1, params.voxel_capacity / std::size_t(side_ * side_ * side_))),
+      hash_(std::max<std::size_t>(1, voxel_capacity(params) / std::size_t(side_ * side_ * side_))),
       observations_(zeroed_pool<Observation>(1)),
       nearest_(zeroed_pool<NearestObservation>(1)),
       observation_count_(zeroed_pool<std::uint8_t>(1)),

@@ -38,13 +38,17 @@ struct ObservationGridParams {
   // A block spans the geometry block's extent (8 TSDF voxels): (block_size_m / voxel_size_m)^3
   // voxels, 2^3 or 4^3 with the defaults.
   double block_size_m = 0.04;
-  int observations_per_voxel = 30;        // m
-  std::size_t voxel_capacity = 1u << 20;  // pool size; exhaustion is a glint::Error
-  int allocation_stride_px = 2;           // every n-th pixel of every n-th row allocates
-  double depth_tolerance_m = 0.01;        // |measured - voxel depth| allowed, plus ...
-  double depth_tolerance_sigmas = 3;      // ... this many Kinect sigma(z) (render/sensor.h)
-  double min_view_cosine = 0.1;           // normal . direction of an accepted observation
-  int geometry_refresh_frames = 8;        // surface point / normal recomputed this often
+  int observations_per_voxel = 30;  // m
+  // Pool size; exhaustion is a glint::Error. 0: 2^20 voxels at 2 cm and above, and
+  // 2 (0.02 / voxel_size_m)^2 times that below (a surface holds (0.02 / v)^2 times as many
+  // voxels, and finer grids leave more of each block empty). About 1.1 KB per voxel, committed
+  // as voxels are used.
+  std::size_t voxel_capacity = 0;
+  int allocation_stride_px = 2;       // every n-th pixel of every n-th row allocates
+  double depth_tolerance_m = 0.01;    // |measured - voxel depth| allowed, plus ...
+  double depth_tolerance_sigmas = 3;  // ... this many Kinect sigma(z) (render/sensor.h)
+  double min_view_cosine = 0.1;       // normal . direction of an accepted observation
+  int geometry_refresh_frames = 8;    // surface point / normal recomputed this often
 };
 
 // One voxel seen in the current frame: its pool index and the pixel it projects to.
