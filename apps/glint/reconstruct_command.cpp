@@ -122,18 +122,22 @@ void run_reconstruct(ReconstructOptions options) {
     for (std::size_t i = 0; i < frames; ++i) {
       Stopwatch watch;
       const io::RgbdFrame frame = io::read_rgbd_frame(sequence, i);
-      const auto truth_segments =
-          options.ground_truth_segmentation
-              ? std::optional(reflectance::read_ground_truth_segments(sequence, i))
-              : std::nullopt;
-      command_timings.add("read", watch.elapsed_ms());
-      const reflectance::ReflectanceFrame result =
-          pipeline.process(frame, truth_segments ? &*truth_segments : nullptr);
-      if (!result.geometry.integrated) ++lost;
       const bool last = i + 1 == frames;
       const bool evaluate =
           has_truth && options.evaluate_every > 0 && (int(i) % options.evaluate_every == 0 || last);
       const bool render = last || (options.render_every > 0 && int(i) % options.render_every == 0);
+      // The gt/ maps of a scored frame also hold its segment ids: each file is read once.
+      std::optional<reflectance::GroundTruthMaps> truth;
+      if (evaluate) {
+        truth = reflectance::read_ground_truth_maps(sequence, i);
+      } else if (options.ground_truth_segmentation) {
+        truth.emplace();
+        truth->segment = reflectance::read_ground_truth_segments(sequence, i);
+      }
+      command_timings.add("read", watch.elapsed_ms());
+      const reflectance::ReflectanceFrame result =
+          pipeline.process(frame, options.ground_truth_segmentation ? &truth->segment : nullptr);
+      if (!result.geometry.integrated) ++lost;
       if (result.geometry.integrated && (evaluate || render)) {
         watch.restart();
         const Pose& pose = result.geometry.camera_to_world;
@@ -142,9 +146,7 @@ void run_reconstruct(ReconstructOptions options) {
         const reflectance::MaterialMaps maps = reflectance::render_material_maps(
             view, pose, pipeline.observations(), pipeline.materials(), pipeline.lights(),
             pipeline.exposure());
-        if (evaluate)
-          evaluation.add_frame(int(i), maps, reflectance::read_ground_truth_maps(sequence, i),
-                               frame.colour);
+        if (evaluate) evaluation.add_frame(int(i), maps, *truth, frame.colour);
         if (render) write_frame_pictures(options.output, int(i), frame.colour, maps);
         command_timings.add("evaluate", watch.elapsed_ms());
       }
