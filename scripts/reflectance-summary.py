@@ -23,6 +23,11 @@ def load(out, scene, variant):
     return json.load(open(path)) if os.path.exists(path) else None
 
 
+def scored(report):
+    """Whether a run scored frames against gt/ (timing runs use --eval-every 0)."""
+    return bool(report and report.get("evaluation") and report["evaluation"].get("average"))
+
+
 def table1(report, title):
     ev = report["evaluation"]
     objects = sorted(ev["objects"], key=int)
@@ -56,13 +61,13 @@ def main():
     for scene in scenes:
         for variant in ["gtseg", "ownseg", "unmodified", "gtseg-1cm", "fast"]:
             r = load(out, scene, variant)
-            if r and r.get("evaluation"):
+            if scored(r):
                 lines.append(averages_row(r, f"{scene} / {variant}"))
     lines.append("")
     for scene in scenes:
         for variant in ["gtseg", "ownseg", "unmodified"]:
             r = load(out, scene, variant)
-            if r and r.get("evaluation"):
+            if scored(r):
                 lines += table1(r, f"{scene}, {variant}")
     for grid, variant in [("2cm", "gtseg"), ("1cm", "gtseg-1cm"), ("2cm", "ownseg"),
                           ("2cm", "fast")]:
@@ -74,7 +79,7 @@ def main():
             cells = []
             for s in scenes:
                 r = reports[s]
-                t = r["timings_ms"].get(stage) if r else None
+                t = r.get("timings_ms", {}).get(stage) if r else None
                 cells.append(f"{t['median']:.1f} ({t['mean']:.1f})" if t else "-")
             lines.append(f"| {stage} | " + " | ".join(cells) + " |")
         lines.append("| paper total (GTX 1080) | " +
