@@ -42,12 +42,23 @@ struct Box {
   int x0, y0, x1, y1;  // inclusive-exclusive
 };
 
-ImageF crop(const ImageF& image, const Box& box) {
+// The box's part of the image; with a mask, pixels outside it are zero.
+ImageF crop(const ImageF& image, const Box& box, const ImageF* mask = nullptr) {
   ImageF out(box.x1 - box.x0, box.y1 - box.y0, image.channels());
   for (int c = 0; c < image.channels(); ++c)
     for (int y = box.y0; y < box.y1; ++y)
-      for (int x = box.x0; x < box.x1; ++x) out.at(x - box.x0, y - box.y0, c) = image.at(x, y, c);
+      for (int x = box.x0; x < box.x1; ++x)
+        out.at(x - box.x0, y - box.y0, c) =
+            !mask || mask->at(x, y, 0) >= 0.5f ? image.at(x, y, c) : 0.0f;
   return out;
+}
+
+// SSIM's 11x11 window reaches 5 pixels from its centre (denoise/metrics.h).
+constexpr int kSsimRadius = 5;
+
+Box grown(const Box& box, int margin, int width, int height) {
+  return {std::max(box.x0 - margin, 0), std::max(box.y0 - margin, 0),
+          std::min(box.x1 + margin, width), std::min(box.y1 + margin, height)};
 }
 
 Scores score(const ImageF& truth, const ImageF& estimate, const ImageF& mask, const Box& box) {
@@ -71,6 +82,17 @@ Scores score(const ImageF& truth, const ImageF& estimate, const ImageF& mask, co
   // SSIM over the object's bounding box (the masked mean is the same; it is far cheaper).
   const ImageF box_mask = crop(mask, box);
   s.ssim = denoise::ssim(crop(truth, box), crop(estimate, box), &box_mask);
+
+  // Whole frame, the object alone (zero elsewhere in both images): outside the object the
+  // error is zero, and every SSIM window more than its radius away from the object sees two
+  // equal zero patches (SSIM 1), so only the object's box grown by that radius is computed.
+  const double frame_pixels = double(truth.width()) * truth.height();
+  s.psnr_frame = -10.0 * std::log10(std::max(squared / (frame_pixels * truth.channels()), 1e-10));
+  const Box around = grown(box, kSsimRadius, truth.width(), truth.height());
+  const double around_pixels = double(around.x1 - around.x0) * (around.y1 - around.y0);
+  const double ssim_around =
+      denoise::ssim(crop(truth, around, &mask), crop(estimate, around, &mask));
+  s.ssim_frame = (ssim_around * around_pixels + (frame_pixels - around_pixels)) / frame_pixels;
   return s;
 }
 
@@ -90,12 +112,19 @@ Scores mean_of(const std::vector<Scores>& all) {
     mean.rmse += s.rmse / all.size();
     mean.psnr += s.psnr / all.size();
     mean.ssim += s.ssim / all.size();
+    mean.psnr_frame += s.psnr_frame / all.size();
+    mean.ssim_frame += s.ssim_frame / all.size();
   }
   return mean;
 }
 
 nlohmann::json scores_json(const Scores& s) {
-  return {{"l1", s.l1}, {"rmse", s.rmse}, {"psnr", s.psnr}, {"ssim", s.ssim}};
+  return {{"l1", s.l1},
+          {"rmse", s.rmse},
+          {"psnr", s.psnr},
+          {"ssim", s.ssim},
+          {"psnr_frame", s.psnr_frame},
+          {"ssim_frame", s.ssim_frame}};
 }
 
 }  // namespace

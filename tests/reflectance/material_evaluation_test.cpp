@@ -46,6 +46,8 @@ TEST(MaterialEvaluation, ExactEstimatesScorePerfectly) {
       EXPECT_EQ(scores.at(q).rmse, 0.0);
       EXPECT_DOUBLE_EQ(scores.at(q).psnr, 100.0) << "capped";
       EXPECT_NEAR(scores.at(q).ssim, 1.0, 1e-9);
+      EXPECT_DOUBLE_EQ(scores.at(q).psnr_frame, 100.0);
+      EXPECT_NEAR(scores.at(q).ssim_frame, 1.0, 1e-9);
     }
 }
 
@@ -61,6 +63,10 @@ TEST(MaterialEvaluation, ConstantErrorGivesKnownL1RmsePsnr) {
   EXPECT_NEAR(kd.l1, 0.1, 1e-6);
   EXPECT_NEAR(kd.rmse, 0.1, 1e-6);
   EXPECT_NEAR(kd.psnr, 20.0, 1e-4);
+  // Over the whole frame the error covers one half of it: MSE / 2, so 10 log10(2) dB more.
+  EXPECT_NEAR(kd.psnr_frame, 20.0 + 10 * std::log10(2.0), 1e-4);
+  EXPECT_GT(kd.ssim_frame, kd.ssim);
+  EXPECT_LT(kd.ssim_frame, 1.0);
   EXPECT_EQ(evaluation.average().at(Quantity::ks).l1, 0.0);
   // Figure 4's series: per object, per frame, estimate and truth of the red channel.
   ASSERT_EQ(evaluation.series().at(1).size(), 2u);
