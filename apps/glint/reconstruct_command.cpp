@@ -47,6 +47,7 @@ struct ReconstructOptions {
   int evaluate_every = 5;
   int render_every = 0;  // 0: only the last frame
   std::string views;     // TUM trajectory of extra poses to re-render at the end
+  std::string albedo_average = "median";
   reflectance::ReflectanceParams params;
 };
 
@@ -88,6 +89,7 @@ reflectance::LightEstimate load_lights(const ReconstructOptions& options) {
 
 void run_reconstruct(ReconstructOptions options) {
   Stopwatch total;
+  options.params.albedo_average = reflectance::parse_albedo_average(options.albedo_average);
   const io::RgbdSequence sequence = io::open_rgbd_sequence(options.sequence);
   const std::size_t frames =
       options.frames ? std::min(options.frames, sequence.frames.size()) : sequence.frames.size();
@@ -208,6 +210,7 @@ void run_reconstruct(ReconstructOptions options) {
                    {{"obs_voxel_m", options.params.observations.voxel_size_m},
                     {"voxel_m", options.params.geometry.volume.voxel_size_m},
                     {"observations_per_voxel", options.params.observations.observations_per_voxel},
+                    {"albedo_average", options.albedo_average},
                     {"ground_truth_poses", options.params.geometry.use_ground_truth_poses},
                     {"ground_truth_segmentation", options.ground_truth_segmentation},
                     {"exposure", options.params.exposure},
@@ -273,6 +276,12 @@ void register_reconstruct_command(CLI::App& app) {
       ->add_option("--albedo-every", params.albedo_refresh_frames,
                    "Re-solve each visible voxel's albedo every N frames (staggered)")
       ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command
+      ->add_option("--albedo-average", options->albedo_average,
+                   "Combine a voxel's per-observation albedos (eq. 7) by their mean (the paper) "
+                   "or their per-channel median (robust to mispredicted highlights)")
+      ->check(CLI::IsMember({"mean", "median"}))
       ->capture_default_str();
   command->add_option("--seed", params.specular.seed, "Seed of the voxel sampling")
       ->capture_default_str();

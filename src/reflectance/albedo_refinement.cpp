@@ -1,7 +1,15 @@
 #include "reflectance/albedo_refinement.h"
 
+#include <algorithm>
+#include <array>
+#include <numeric>
+
+#include "core/error.h"
+
 namespace glint::reflectance {
 namespace {
+
+constexpr int kMaxObservations = 255;  // insert_observation's capacity limit
 
 // Unit direction to the light and L_l cos(theta_i) (zero when the light is behind the surface).
 struct Incidence {
@@ -20,41 +28,60 @@ Incidence incidence(const render::PointLight& light, const Eigen::Vector3f& posi
   return {wi, light.intensity * (cos_i / distance2)};
 }
 
+// Median of values[0, n), n >= 1; reorders them.
+float median(float* values, int n) {
+  const int middle = n / 2;
+  std::nth_element(values, values + middle, values + n);
+  if (n % 2 == 1) return values[middle];
+  return 0.5f * (values[middle] + *std::max_element(values, values + middle));
+}
+
 }  // namespace
+
+AlbedoAverage parse_albedo_average(const std::string& name) {
+  if (name == "mean") return AlbedoAverage::mean;
+  if (name == "median") return AlbedoAverage::median;
+  throw Error("albedo average", name, "must be mean or median");
+}
 
 std::optional<Eigen::Vector3f> refine_albedo(const Observation* observations, int count,
                                              const Eigen::Vector3f& position,
                                              const Eigen::Vector3f& normal,
                                              const std::vector<render::PointLight>& lights,
-                                             const Eigen::Vector3f& ks, float alpha) {
-  // Eq. (7) is linear in B_k and in the specular sum, so its mean over the observations is
-  // eq. (7) of the mean colour and the mean specular sum: each light's incidence is computed
-  // once per voxel, not once per observation.
-  Eigen::Vector3f colour_sum = Eigen::Vector3f::Zero();
+                                             const Eigen::Vector3f& ks, float alpha,
+                                             AlbedoAverage average) {
+  std::array<const Observation*, kMaxObservations> seen;  // from above the surface
   int used = 0;
-  for (int k = 0; k < count; ++k)
-    if (normal.dot(observations[k].direction) > 0.0f) {
-      colour_sum += observations[k].colour;
-      ++used;
-    }
+  for (int k = 0; k < std::min(count, kMaxObservations); ++k)
+    if (normal.dot(observations[k].direction) > 0.0f) seen[used++] = &observations[k];
   if (used == 0) return std::nullopt;
 
-  Eigen::Vector3f diffuse = Eigen::Vector3f::Zero();   // sum_l L_l cos
-  Eigen::Vector3f specular = Eigen::Vector3f::Zero();  // sum_k sum_l exp(gamma)/N L_l cos
+  // Per observation sum_l exp(gamma_l) / N_l * L_l cos(theta_i,l); each light's incidence is
+  // computed once per voxel.
+  std::array<Eigen::Vector3f, kMaxObservations> specular;
+  std::fill_n(specular.begin(), used, Eigen::Vector3f::Zero());
+  Eigen::Vector3f diffuse = Eigen::Vector3f::Zero();  // sum_l L_l cos(theta_i,l)
   for (const render::PointLight& light : lights) {
     const Incidence in = incidence(light, position, normal);
     if (in.irradiance.isZero()) continue;  // the light is behind the surface
     diffuse += in.irradiance;
-    float lobe_sum = 0.0f;
-    for (int k = 0; k < count; ++k)
-      if (normal.dot(observations[k].direction) > 0.0f)
-        lobe_sum +=
-            render::ward_specular_lobe(normal, in.direction, observations[k].direction, alpha);
-    specular += in.irradiance * lobe_sum;
+    for (int j = 0; j < used; ++j)
+      specular[j] += in.irradiance *
+                     render::ward_specular_lobe(normal, in.direction, seen[j]->direction, alpha);
   }
   if (diffuse.minCoeff() <= 1e-12f) return std::nullopt;
-  return float(M_PI) * (colour_sum - ks.cwiseProduct(specular)).cwiseQuotient(diffuse) /
-         float(used);
+
+  // Eq. (7) per observation and channel.
+  Eigen::Vector3f kd;
+  std::array<float, kMaxObservations> values;
+  for (int c = 0; c < 3; ++c) {
+    for (int j = 0; j < used; ++j)
+      values[j] = float(M_PI) * (seen[j]->colour[c] - ks[c] * specular[j][c]) / diffuse[c];
+    kd[c] = average == AlbedoAverage::median
+                ? median(values.data(), used)
+                : std::accumulate(values.begin(), values.begin() + used, 0.0f) / float(used);
+  }
+  return kd;
 }
 
 }  // namespace glint::reflectance

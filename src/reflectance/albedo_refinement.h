@@ -3,10 +3,12 @@
 // voxel normal fixed, every observation B_k of a voxel gives one diffuse albedo by solving
 // eq. (6) for kd, eq. (7):
 //   kd = pi * (B_k - ks * sum_l exp(gamma_l) / N_l * L_l cos(theta_i,l)) / sum_l L_l cos(theta_i,l)
-// and the voxel's kd is the mean over its observations. L_l = intensity_l / r_l^2 (near-field
-// point lights); shadowing is ignored, as in the paper.
+// and the voxel's kd is the mean over its observations (the paper) or, more robustly, their
+// per-channel median. L_l = intensity_l / r_l^2 (near-field point lights); shadowing is
+// ignored, as in the paper.
 #include <Eigen/Core>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "reflectance/observation.h"
@@ -14,12 +16,20 @@
 
 namespace glint::reflectance {
 
-// Mean of eq. (7) over the voxel's observations (those seen from above the surface); nullopt
-// when there is none or no light reaches the surface point. No allocation.
+// How a voxel's per-observation albedos are combined. The median resists the observations
+// whose specular term is mispredicted: near the mirror direction of a light a small error in
+// the segment's alpha or ks changes the lobe, and so that observation's kd, a lot.
+enum class AlbedoAverage { mean, median };
+AlbedoAverage parse_albedo_average(const std::string& name);  // "mean" | "median"
+
+// Eq. (7) over the voxel's observations (those seen from above the surface, at most 255),
+// combined by `average`; nullopt when there is none or no light reaches the surface point.
+// No allocation.
 std::optional<Eigen::Vector3f> refine_albedo(const Observation* observations, int count,
                                              const Eigen::Vector3f& position,
                                              const Eigen::Vector3f& normal,
                                              const std::vector<render::PointLight>& lights,
-                                             const Eigen::Vector3f& ks, float alpha);
+                                             const Eigen::Vector3f& ks, float alpha,
+                                             AlbedoAverage average = AlbedoAverage::mean);
 
 }  // namespace glint::reflectance

@@ -33,9 +33,9 @@ void ReflectancePipeline::refine_albedo_of_visible() {
     if (grid_.has_refined_kd(v) && (v + frame_) % params_.albedo_refresh_frames != 0) return;
     const SegmentMaterial* material = specular_.material(grid_.segment(v));
     if (!material) return;
-    const auto kd =
-        refine_albedo(grid_.observations(v), grid_.observation_count(v), grid_.position(v),
-                      grid_.normal(v), lights_, material->ward.ks, material->ward.alpha);
+    const auto kd = refine_albedo(grid_.observations(v), grid_.observation_count(v),
+                                  grid_.position(v), grid_.normal(v), lights_, material->ward.ks,
+                                  material->ward.alpha, params_.albedo_average);
     // Each voxel is written by one iteration only: the visible list holds it once.
     grid_.has_refined_kd(v) = kd.has_value();
     if (kd) grid_.refined_kd(v) = kd->cwiseMax(0.0f).cwiseMin(1.0f);

@@ -4,6 +4,8 @@
 
 #include <vector>
 
+#include "core/error.h"
+
 namespace glint::reflectance {
 namespace {
 
@@ -55,6 +57,35 @@ TEST(AlbedoRefinement, RecoversTheDiffuseAlbedoOfARenderedVoxel) {
   const auto diffuse_only = refine_albedo(obs.data(), int(obs.size()), position, normal, lights,
                                           Eigen::Vector3f::Zero(), m.alpha);
   EXPECT_GT(diffuse_only->x(), m.kd.x() + 0.01f);
+}
+
+TEST(AlbedoRefinement, MedianIgnoresAMispredictedHighlight) {
+  render::WardMaterial m;
+  m.kd = {0.5f, 0.4f, 0.3f};
+  m.ks = {0.2f, 0.2f, 0.2f};
+  m.alpha = 0.1f;
+  std::vector<render::PointLight> lights(1);
+  lights[0].position = {0.3, 1.5, 0.2};
+  lights[0].intensity = {2, 2, 2};
+  const Eigen::Vector3f position = Eigen::Vector3f::Zero(), normal = Eigen::Vector3f::UnitY();
+  std::vector<Observation> obs;
+  for (int k = 0; k < 9; ++k) {
+    Observation o;
+    o.direction = Eigen::Vector3f(std::cos(0.7f * k), 1.0f, std::sin(0.7f * k)).normalized();
+    o.colour = observed(m, position, normal, o.direction, lights);
+    obs.push_back(o);
+  }
+  obs[4].colour *= 3.0f;  // a highlight the segment's ks and alpha do not predict
+  const auto median = refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks,
+                                    m.alpha, AlbedoAverage::median);
+  const auto mean = refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks,
+                                  m.alpha, AlbedoAverage::mean);
+  ASSERT_TRUE(median && mean);
+  // Each clean observation alone gives kd exactly; the median is one of them.
+  EXPECT_TRUE(median->isApprox(m.kd, 1e-4f)) << median->transpose();
+  EXPECT_GT(mean->x(), m.kd.x() + 0.05f);
+  EXPECT_EQ(parse_albedo_average("median"), AlbedoAverage::median);
+  EXPECT_THROW(parse_albedo_average("mode"), Error);
 }
 
 TEST(AlbedoRefinement, UnlitOrUnseenVoxelsHaveNoEstimate) {
