@@ -4,6 +4,7 @@
 # model has none) and its low-exposure light capture, estimates the lights (glint lights), then
 # runs glint reconstruct with ground-truth poses:
 #   - with ground-truth and with glint's own segmentation, at 2 cm observation voxels;
+#   - with the paper's mean of the per-observation albedos instead of glint's median;
 #   - with the modified (parabolic, lambda_d 0.1, lambda_l 0.3) and the unmodified
 #     (orthographic, lambda 1) HemiCNN, ground-truth segmentation;
 #   - at 1 cm observation voxels (Table 3 timings);
@@ -37,6 +38,8 @@ for scene in $SCENES; do
   }
   run gtseg --gt-segmentation --model "$MODELS/hemicnn.json" --eval-every 10
   run ownseg --model "$MODELS/hemicnn.json" --eval-every 10
+  run mean-albedo --gt-segmentation --model "$MODELS/hemicnn.json" --eval-every 10 \
+    --albedo-average mean
   run unmodified --gt-segmentation --model "$MODELS/hemicnn-unmodified.json" --eval-every 10
   run gtseg-1cm --gt-segmentation --model "$MODELS/hemicnn.json" --obs-voxel 0.01 --eval-every 0
   run fast --gt-segmentation --model "$MODELS/hemicnn.json" --voxel 0.01 --eval-every 0
