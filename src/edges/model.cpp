@@ -167,15 +167,7 @@ void Model::save(const std::string& path) const { io::write_json(path, to_json()
 
 Model Model::load(const std::string& path) {
   const io::JsonFields reader(path);
-  const nlohmann::json root = io::read_json(path);
-  if (!root.is_object()) reader.fail("", "expected a JSON object at the top level");
-
-  const nlohmann::json& format = reader.member(root, "format");
-  if (!format.is_string() || format.get<std::string>() != kFormatName)
-    reader.fail("format", fmt::format("expected \"{}\"", kFormatName));
-  if (const int version = reader.integer(root, "version"); version != kFormatVersion)
-    reader.fail("version", fmt::format("unsupported version {} (this glint reads {})", version,
-                                       kFormatVersion));
+  const nlohmann::json root = reader.read_document(kFormatName, kFormatVersion);
 
   const nlohmann::json& classes = reader.member(root, "classes");
   if (!classes.is_array() || (classes.size() != 2 && classes.size() != 3))

@@ -6,6 +6,7 @@
 #include <cstdlib>
 
 #include "core/error.h"
+#include "io/json_report.h"
 
 namespace glint::io {
 namespace {
@@ -15,6 +16,17 @@ std::string key_path(const std::string& where, const std::string& key) {
 }
 
 }  // namespace
+
+nlohmann::json JsonFields::read_document(const std::string& format, int version) const {
+  nlohmann::json root = read_json(path_);
+  if (!root.is_object()) fail("", "expected a JSON object at the top level");
+  if (string(root, "format") != format) fail("format", fmt::format("expected \"{}\"", format));
+  const nlohmann::json& found = member(root, "version");
+  if (found != version)
+    fail("version",
+         fmt::format("unsupported version {} (this glint reads {})", found.dump(), version));
+  return root;
+}
 
 void JsonFields::fail(const std::string& key, const std::string& reason) const {
   throw Error(path_, key, reason);

@@ -14,6 +14,10 @@ class JsonFields {
 
   [[noreturn]] void fail(const std::string& key, const std::string& reason) const;
 
+  // Reads the file, which must hold a JSON object whose "format" is `format` and whose
+  // "version" is `version`.
+  nlohmann::json read_document(const std::string& format, int version) const;
+
   // object[key]; `where` is the key path of `object` ("" at the top level).
   const nlohmann::json& member(const nlohmann::json& object, const std::string& key,
                                const std::string& where = "") const;

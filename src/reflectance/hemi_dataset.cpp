@@ -102,14 +102,7 @@ HemiDataset read_hemi_dataset(const std::string& directory) {
   if (!std::filesystem::is_regular_file(index_path))
     throw Error(index_path, "", "missing: not a HemiCNN dataset folder (no index.json)");
   const io::JsonFields reader(index_path);
-  const nlohmann::json root = io::read_json(index_path);
-  if (!root.is_object()) reader.fail("", "expected a JSON object at the top level");
-  if (reader.string(root, "format", "") != kFormatName)
-    reader.fail("format", fmt::format("expected \"{}\"", kFormatName));
-  const nlohmann::json& version = reader.member(root, "version", "");
-  if (version != kFormatVersion)
-    reader.fail("version", fmt::format("unsupported version {} (this glint reads {})",
-                                       version.dump(), kFormatVersion));
+  const nlohmann::json root = reader.read_document(kFormatName, kFormatVersion);
 
   HemiDataset dataset;
   dataset.directory = directory;

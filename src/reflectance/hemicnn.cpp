@@ -258,15 +258,7 @@ void HemiCnn::save(const std::string& path) const { io::write_json(path, to_json
 
 HemiCnn HemiCnn::load(const std::string& path) {
   const io::JsonFields reader(path);
-  const nlohmann::json root = io::read_json(path);
-  if (!root.is_object()) reader.fail("", "expected a JSON object at the top level");
-
-  const nlohmann::json& format = reader.member(root, "format", "");
-  if (!format.is_string() || format.get<std::string>() != kFormatName)
-    reader.fail("format", fmt::format("expected \"{}\"", kFormatName));
-  if (const int version = reader.integer(root, "version"); version != kFormatVersion)
-    reader.fail("version", fmt::format("unsupported version {} (this glint reads {})", version,
-                                       kFormatVersion));
+  const nlohmann::json root = reader.read_document(kFormatName, kFormatVersion);
 
   HemiCnnConfig config;
   config.image_size = reader.integer(root, "image_size");
