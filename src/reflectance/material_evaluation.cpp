@@ -85,10 +85,12 @@ Scores score(const ImageF& truth, const ImageF& estimate, const ImageF& mask, co
 
   // Whole frame, the object alone (zero elsewhere in both images): outside the object the
   // error is zero, and every SSIM window more than its radius away from the object sees two
-  // equal zero patches (SSIM 1), so only the object's box grown by that radius is computed.
+  // equal zero patches (SSIM 1). So only the object's box grown by twice the radius is
+  // computed: windows within one radius of the box then stay inside the crop, where the
+  // zero-padded border of denoise::ssim would otherwise change their means.
   const double frame_pixels = double(truth.width()) * truth.height();
   s.psnr_frame = -10.0 * std::log10(std::max(squared / (frame_pixels * truth.channels()), 1e-10));
-  const Box around = grown(box, kSsimRadius, truth.width(), truth.height());
+  const Box around = grown(box, 2 * kSsimRadius, truth.width(), truth.height());
   const double around_pixels = double(around.x1 - around.x0) * (around.y1 - around.y0);
   const double ssim_around =
       denoise::ssim(crop(truth, around, &mask), crop(estimate, around, &mask));

@@ -5,6 +5,8 @@
 
 #include <cmath>
 
+#include "denoise/metrics.h"
+
 namespace glint::reflectance {
 namespace {
 
@@ -72,6 +74,30 @@ TEST(MaterialEvaluation, ConstantErrorGivesKnownL1RmsePsnr) {
   ASSERT_EQ(evaluation.series().at(1).size(), 2u);
   EXPECT_NEAR(evaluation.series().at(1)[1].kd, 0.5, 1e-6);
   EXPECT_NEAR(evaluation.series().at(1)[1].true_kd, 0.4, 1e-6);
+}
+
+TEST(MaterialEvaluation, WholeFrameSsimEqualsSsimOfTheMaskedFrames) {
+  // A 12 x 10 object inside the frame with a textured error, so that the shortcut (SSIM over the
+  // object's box grown by the window radius) must match the SSIM of the full masked frames.
+  GroundTruthMaps t = truth();
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x)
+      t.segment.at(x, y, 0) = x >= 14 && x < 26 && y >= 10 && y < 20 ? 1 : 0;
+  const ImageF input(kWidth, kHeight, 3, 0.25f);
+  MaterialMaps estimate = exact(t, input);
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) estimate.alpha.at(x, y, 0) += 0.05f * ((x * 7 + y * 3) % 5);
+  MaterialEvaluation evaluation(10);
+  evaluation.add_frame(0, estimate, t, input);
+  ImageF truth_masked(kWidth, kHeight, 1), estimate_masked(kWidth, kHeight, 1);
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x)
+      if (t.segment.at(x, y, 0) == 1) {
+        truth_masked.at(x, y, 0) = t.alpha.at(x, y, 0);
+        estimate_masked.at(x, y, 0) = estimate.alpha.at(x, y, 0);
+      }
+  EXPECT_NEAR(evaluation.average().at(Quantity::alpha).ssim_frame,
+              denoise::ssim(truth_masked, estimate_masked), 1e-9);
 }
 
 TEST(MaterialEvaluation, UncoveredAndTinyObjectsAreNotScored) {
