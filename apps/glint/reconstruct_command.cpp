@@ -47,7 +47,6 @@ struct ReconstructOptions {
   int evaluate_every = 5;
   int render_every = 0;  // 0: only the last frame
   std::string views;     // TUM trajectory of extra poses to re-render at the end
-  std::string albedo_average = "median";
   reflectance::ReflectanceParams params;
 };
 
@@ -89,7 +88,6 @@ reflectance::LightEstimate load_lights(const ReconstructOptions& options) {
 
 void run_reconstruct(ReconstructOptions options) {
   Stopwatch total;
-  options.params.albedo_average = reflectance::parse_albedo_average(options.albedo_average);
   const io::RgbdSequence sequence = io::open_rgbd_sequence(options.sequence);
   const std::size_t frames =
       options.frames ? std::min(options.frames, sequence.frames.size()) : sequence.frames.size();
@@ -200,27 +198,28 @@ void run_reconstruct(ReconstructOptions options) {
       options.output);
   if (options.report.empty()) return;
   nlohmann::json command = command_timings.to_json();
-  io::write_json(options.report,
-                 {{"command", command_line()},
-                  {"input", options.sequence},
-                  {"format", sequence.format},
-                  {"frames", frames},
-                  {"tracking_lost_frames", lost},
-                  {"parameters",
-                   {{"obs_voxel_m", options.params.observations.voxel_size_m},
-                    {"voxel_m", options.params.geometry.volume.voxel_size_m},
-                    {"observations_per_voxel", options.params.observations.observations_per_voxel},
-                    {"albedo_average", options.albedo_average},
-                    {"ground_truth_poses", options.params.geometry.use_ground_truth_poses},
-                    {"ground_truth_segmentation", options.ground_truth_segmentation},
-                    {"exposure", options.params.exposure},
-                    {"model", model_path},
-                    {"lights", lights.capture}}},
-                  {"timings_ms", timings.to_json()},
-                  {"command_timings_ms", command},
-                  {"materials", materials_json(pipeline)},
-                  {"evaluation", has_truth ? evaluation.to_json() : nlohmann::json(nullptr)},
-                  {"total_s", total.elapsed_s()}});
+  io::write_json(
+      options.report,
+      {{"command", command_line()},
+       {"input", options.sequence},
+       {"format", sequence.format},
+       {"frames", frames},
+       {"tracking_lost_frames", lost},
+       {"parameters",
+        {{"obs_voxel_m", options.params.observations.voxel_size_m},
+         {"voxel_m", options.params.geometry.volume.voxel_size_m},
+         {"observations_per_voxel", options.params.observations.observations_per_voxel},
+         {"albedo_average", reflectance::albedo_average_name(options.params.albedo_average)},
+         {"ground_truth_poses", options.params.geometry.use_ground_truth_poses},
+         {"ground_truth_segmentation", options.ground_truth_segmentation},
+         {"exposure", options.params.exposure},
+         {"model", model_path},
+         {"lights", lights.capture}}},
+       {"timings_ms", timings.to_json()},
+       {"command_timings_ms", command},
+       {"materials", materials_json(pipeline)},
+       {"evaluation", has_truth ? evaluation.to_json() : nlohmann::json(nullptr)},
+       {"total_s", total.elapsed_s()}});
 }
 
 }  // namespace
@@ -278,11 +277,15 @@ void register_reconstruct_command(CLI::App& app) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   command
-      ->add_option("--albedo-average", options->albedo_average,
-                   "Combine a voxel's per-observation albedos (eq. 7) by their mean (the paper) "
-                   "or their per-channel median (robust to mispredicted highlights)")
+      ->add_option_function<std::string>(
+          "--albedo-average",
+          [options](const std::string& name) {
+            options->params.albedo_average = reflectance::parse_albedo_average(name);
+          },
+          "Combine a voxel's per-observation albedos (eq. 7) by their mean (the paper) or their "
+          "per-channel median (robust to mispredicted highlights)")
       ->check(CLI::IsMember({"mean", "median"}))
-      ->capture_default_str();
+      ->default_str(reflectance::albedo_average_name(params.albedo_average));
   command->add_option("--seed", params.specular.seed, "Seed of the voxel sampling")
       ->capture_default_str();
   command->add_option("--report", options->report,

@@ -9,8 +9,6 @@
 namespace glint::reflectance {
 namespace {
 
-constexpr int kMaxObservations = 255;  // insert_observation's capacity limit
-
 // Unit direction to the light and L_l cos(theta_i) (zero when the light is behind the surface).
 struct Incidence {
   Eigen::Vector3f direction;
@@ -38,9 +36,13 @@ float median(float* values, int n) {
 
 }  // namespace
 
+const char* albedo_average_name(AlbedoAverage average) {
+  return average == AlbedoAverage::median ? "median" : "mean";
+}
+
 AlbedoAverage parse_albedo_average(const std::string& name) {
-  if (name == "mean") return AlbedoAverage::mean;
-  if (name == "median") return AlbedoAverage::median;
+  for (const AlbedoAverage average : {AlbedoAverage::mean, AlbedoAverage::median})
+    if (name == albedo_average_name(average)) return average;
   throw Error("albedo average", name, "must be mean or median");
 }
 
@@ -50,15 +52,15 @@ std::optional<Eigen::Vector3f> refine_albedo(const Observation* observations, in
                                              const std::vector<render::PointLight>& lights,
                                              const Eigen::Vector3f& ks, float alpha,
                                              AlbedoAverage average) {
-  std::array<const Observation*, kMaxObservations> seen;  // from above the surface
+  std::array<const Observation*, kMaxObservationsPerVoxel> seen;  // from above the surface
   int used = 0;
-  for (int k = 0; k < std::min(count, kMaxObservations); ++k)
+  for (int k = 0; k < std::min(count, kMaxObservationsPerVoxel); ++k)
     if (normal.dot(observations[k].direction) > 0.0f) seen[used++] = &observations[k];
   if (used == 0) return std::nullopt;
 
   // Per observation sum_l exp(gamma_l) / N_l * L_l cos(theta_i,l); each light's incidence is
   // computed once per voxel.
-  std::array<Eigen::Vector3f, kMaxObservations> specular;
+  std::array<Eigen::Vector3f, kMaxObservationsPerVoxel> specular;
   std::fill_n(specular.begin(), used, Eigen::Vector3f::Zero());
   Eigen::Vector3f diffuse = Eigen::Vector3f::Zero();  // sum_l L_l cos(theta_i,l)
   for (const render::PointLight& light : lights) {
@@ -73,7 +75,7 @@ std::optional<Eigen::Vector3f> refine_albedo(const Observation* observations, in
 
   // Eq. (7) per observation and channel.
   Eigen::Vector3f kd;
-  std::array<float, kMaxObservations> values;
+  std::array<float, kMaxObservationsPerVoxel> values;
   for (int c = 0; c < 3; ++c) {
     for (int j = 0; j < used; ++j)
       values[j] = float(M_PI) * (seen[j]->colour[c] - ks[c] * specular[j][c]) / diffuse[c];

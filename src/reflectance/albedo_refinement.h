@@ -20,9 +20,11 @@ namespace glint::reflectance {
 // whose specular term is mispredicted: near the mirror direction of a light a small error in
 // the segment's alpha or ks changes the lobe, and so that observation's kd, a lot.
 enum class AlbedoAverage { mean, median };
-AlbedoAverage parse_albedo_average(const std::string& name);  // "mean" | "median"
+const char* albedo_average_name(AlbedoAverage average);       // "mean" | "median"
+AlbedoAverage parse_albedo_average(const std::string& name);  // throws glint::Error
 
-// Eq. (7) over the voxel's observations (those seen from above the surface, at most 255),
+// Eq. (7) over the voxel's observations (those seen from above the surface, at most
+// kMaxObservationsPerVoxel),
 // combined by `average`; nullopt when there is none or no light reaches the surface point.
 // No allocation.
 std::optional<Eigen::Vector3f> refine_albedo(const Observation* observations, int count,

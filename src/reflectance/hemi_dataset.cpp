@@ -18,16 +18,6 @@ namespace {
 constexpr const char* kFormatName = "glint-hemi-dataset";
 constexpr int kFormatVersion = 1;
 
-// A float as the double of its 9-significant-digit decimal, so the JSON text is short and
-// reads back as the same float.
-double json_float(float value) {
-  return std::strtod(fmt::format("{:.9g}", value).c_str(), nullptr);
-}
-
-nlohmann::json json_vector(const Eigen::Vector3f& v) {
-  return {json_float(v.x()), json_float(v.y()), json_float(v.z())};
-}
-
 // Throws glint::Error(where, element, ...) unless the material is a valid Ward material.
 void check_material(const render::WardMaterial& m, const std::string& where,
                     const std::string& element) {
@@ -181,15 +171,13 @@ void HemiDatasetWriter::finish() {
   nlohmann::json sequences = nlohmann::json::array();
   for (const HemiSequence& entry : entries_) {
     const render::PerceptualWard& t = entry.target;
-    sequences.push_back(
-        {{"file", entry.file},
-         {"target",
-          {json_float(t.lab.x()), json_float(t.lab.y()), json_float(t.lab.z()), json_float(t.c.x()),
-           json_float(t.c.y()), json_float(t.c.z()), json_float(t.d)}},
-         {"kd", json_vector(entry.material.kd)},
-         {"ks", json_vector(entry.material.ks)},
-         {"alpha", json_float(entry.material.alpha)},
-         {"source", entry.source}});
+    const float target[] = {t.lab.x(), t.lab.y(), t.lab.z(), t.c.x(), t.c.y(), t.c.z(), t.d};
+    sequences.push_back({{"file", entry.file},
+                         {"target", io::exact_float_array(target, 7)},
+                         {"kd", io::exact_float_array(entry.material.kd.data(), 3)},
+                         {"ks", io::exact_float_array(entry.material.ks.data(), 3)},
+                         {"alpha", io::exact_float(entry.material.alpha)},
+                         {"source", entry.source}});
   }
   io::write_json((std::filesystem::path(directory_) / "index.json").string(),
                  {{"format", kFormatName},

@@ -61,6 +61,9 @@ Box grown(const Box& box, int margin, int width, int height) {
           std::min(box.x1 + margin, width), std::min(box.y1 + margin, height)};
 }
 
+// PSNR of a mean squared error, peak 1, capped at 100 dB.
+double capped_psnr(double mse) { return -10.0 * std::log10(std::max(mse, 1e-10)); }
+
 Scores score(const ImageF& truth, const ImageF& estimate, const ImageF& mask, const Box& box) {
   double absolute = 0, squared = 0;
   std::size_t count = 0;
@@ -78,7 +81,7 @@ Scores score(const ImageF& truth, const ImageF& estimate, const ImageF& mask, co
   s.l1 = absolute / count;
   const double mse = squared / count;
   s.rmse = std::sqrt(mse);
-  s.psnr = -10.0 * std::log10(std::max(mse, 1e-10));  // capped at 100 dB
+  s.psnr = capped_psnr(mse);
   // SSIM over the object's bounding box (the masked mean is the same; it is far cheaper).
   const ImageF box_mask = crop(mask, box);
   s.ssim = denoise::ssim(crop(truth, box), crop(estimate, box), &box_mask);
@@ -89,7 +92,7 @@ Scores score(const ImageF& truth, const ImageF& estimate, const ImageF& mask, co
   // computed: windows within one radius of the box then stay inside the crop, where the
   // zero-padded border of denoise::ssim would otherwise change their means.
   const double frame_pixels = double(truth.width()) * truth.height();
-  s.psnr_frame = -10.0 * std::log10(std::max(squared / (frame_pixels * truth.channels()), 1e-10));
+  s.psnr_frame = capped_psnr(squared / (frame_pixels * truth.channels()));
   const Box around = grown(box, 2 * kSsimRadius, truth.width(), truth.height());
   const double around_pixels = double(around.x1 - around.x0) * (around.y1 - around.y0);
   const double ssim_around =

@@ -23,7 +23,11 @@ struct NearestObservation {
   std::uint8_t slot = 0;
 };
 
-// Adds `added` to the `count` observations in slots[0, capacity) (capacity <= 255) and returns
+// The most observations a voxel can hold: NearestObservation stores slots as bytes.
+inline constexpr int kMaxObservationsPerVoxel = 255;
+
+// Adds `added` to the `count` observations in slots[0, capacity) (capacity <=
+// kMaxObservationsPerVoxel) and returns
 // the new count; `nearest` holds one entry per slot. When the voxel is full, of the most similar
 // pair (largest direction dot product over all pairs including the new one) the older
 // observation is dropped: newer ones were taken with better-converged geometry. O(capacity)

@@ -64,8 +64,9 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
       segment_(zeroed_pool<std::int32_t>(1)),
       segment_confidence_(zeroed_pool<std::int16_t>(1)),
       has_refined_kd_(zeroed_pool<bool>(1)) {
-  if (params.observations_per_voxel < 1 || params.observations_per_voxel > 255)
-    throw Error("observation grid", "observations_per_voxel", "must be in 1..255");
+  if (params.observations_per_voxel < 1 || params.observations_per_voxel > kMaxObservationsPerVoxel)
+    throw Error("observation grid", "observations_per_voxel",
+                "must be in 1.." + std::to_string(kMaxObservationsPerVoxel));
   if (params.allocation_stride_px < 1)
     throw Error("observation grid", "allocation_stride_px", "must be >= 1");
   const std::size_t voxels = hash_.capacity() * voxels_per_block_;

@@ -78,7 +78,7 @@ TEST(MaterialEvaluation, ConstantErrorGivesKnownL1RmsePsnr) {
 
 TEST(MaterialEvaluation, WholeFrameSsimEqualsSsimOfTheMaskedFrames) {
   // A 12 x 10 object inside the frame with a textured error, so that the shortcut (SSIM over the
-  // object's box grown by the window radius) must match the SSIM of the full masked frames.
+  // object's box grown by twice the window radius) must match the SSIM of the full masked frames.
   GroundTruthMaps t = truth();
   for (int y = 0; y < kHeight; ++y)
     for (int x = 0; x < kWidth; ++x)
