@@ -37,6 +37,7 @@ struct EvalOptions {
   double coverage = 0.3;
   std::uint64_t protocol_seed = 2022;
   bool oracle_guidance = false;
+  int trace_every = 0;
   std::string save;
   std::string report;
   DenoiserOptions denoiser;
@@ -166,9 +167,20 @@ void run_eval(const EvalOptions& options) {
 
     for (const std::string& method : options.methods) {
       const ImageF& guidance = options.oracle_guidance ? clean_mask : estimated_guidance;
-      const DenoiseRun run = run_denoiser(method, options.denoiser, noisy,
-                                          method_is_guided(method) ? &guidance : nullptr);
+      // The quality of the running estimate over the iterations (DIP's Fig. 3-style curves).
+      nlohmann::json trace = nlohmann::json::array();
+      const auto score_estimate = [&](int iteration, const ImageF& estimate) {
+        trace.push_back({{"iteration", iteration},
+                         {"psnr", denoise::psnr(clean, estimate)},
+                         {"psnr_clean", denoise::psnr(clean, estimate, &clean_mask)},
+                         {"psnr_noisy", denoise::psnr(clean, estimate, &mask)}});
+      };
+      const DenoiseRun run =
+          run_denoiser(method, options.denoiser, noisy,
+                       method_is_guided(method) ? &guidance : nullptr, score_estimate,
+                       options.trace_every);
       nlohmann::json values = quality(clean, run.result, mask, clean_mask);
+      if (!trace.empty()) values["trace"] = trace;
       values["seconds"] = run.stats.seconds;
       values["iterations"] = run.stats.iterations;
       record(method, values);
@@ -264,6 +276,12 @@ void register_denoise_eval(CLI::App& denoise) {
   command->add_flag("--oracle-guidance", options->oracle_guidance,
                     "Guide with the true clean mask instead of the estimated map (an upper bound "
                     "that separates the method from the noise-map quality)");
+  command
+      ->add_option("--trace-every", options->trace_every,
+                   "Neural methods: score the running estimate every N iterations into the "
+                   "report (PSNR whole/clean/noisy over the iterations; 0 = off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   command->add_option("--save", options->save, "Folder for clean/noisy/mask/guidance/results");
   command->add_option("--report", options->report, "JSON report (per image and summary)");
   options->denoiser.add_options(*command);

@@ -41,6 +41,10 @@ void DenoiserOptions::add_options(CLI::App& command) {
       ->check(CLI::PositiveNumber);
   command.add_option("--lr", learning_rate, "Adam learning rate (overrides --config)")
       ->check(CLI::PositiveNumber);
+  command
+      .add_option("--input-noise", input_noise,
+                  "DIP: sigma of the per-iteration input perturbation (full 1/30)")
+      ->check(CLI::NonNegativeNumber);
   command.add_option("--pd", discard, "Guided S2S: p_d of eqs (17)-(18) (full 0.01, fast 1)")
       ->check(CLI::Range(0.0, 1.0));
   command.add_option("--dropout", dropout, "S2S: decoder dropout rate (default 0.3)")
@@ -81,6 +85,7 @@ denoise::NeuralParams DenoiserOptions::neural_params(denoise::NeuralMethod metho
   if (learning_rate) p.learning_rate = *learning_rate;
   if (discard && denoise::is_guided(method)) p.masks.discard = *discard;
   if (dropout) p.dropout = *dropout;
+  if (input_noise) p.input_perturbation = *input_noise;
   if (kappa_w) p.decay.warmup = *kappa_w;
   if (kappa_r) p.decay.rate = *kappa_r;
   if (kappa_c) p.decay.floor = *kappa_c;

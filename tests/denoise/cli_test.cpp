@@ -56,11 +56,18 @@ TEST_F(DenoiseCliTest, NoiseMapRunAndEval) {
 
   const CommandResult eval =
       glint("denoise eval --images " + path("clean.png") + " --crop 32" +
-            " --methods nlm,s2s --iterations 3 --predictions 2 --levels 2 --channels 8" +
+            " --methods nlm,s2s --iterations 4 --predictions 2 --levels 2 --channels 8" +
+            " --trace-every 2" +
             " --report " + path("eval.json"));
   ASSERT_EQ(eval.exit_code, 0) << eval.output;
   const auto report = nlohmann::json::parse(std::ifstream(path("eval.json")));
   EXPECT_TRUE(report["summary"].contains("s2s"));
+  // --trace-every 2 over 4 iterations: the running estimate scored at 2 and 4.
+  const auto& trace = report["images"][0]["methods"]["s2s"]["trace"];
+  ASSERT_EQ(trace.size(), 2u);
+  EXPECT_EQ(trace[1]["iteration"], 4);
+  EXPECT_TRUE(trace[1].contains("psnr_noisy"));
+  EXPECT_FALSE(report["summary"]["s2s"].contains("trace"));
   EXPECT_TRUE(report["summary"]["noise map svd"].contains("auc"));
   EXPECT_GT(report["summary"]["nlm"]["psnr"]["mean"].get<double>(), 10.0);
 }
