@@ -24,7 +24,7 @@ void DenoiserOptions::add_options(CLI::App& command) {
   command
       .add_option("--config", config,
                   "full = the paper's settings (5 levels x 128 filters; GPU-sized), fast = "
-                  "CPU-practical (4 x 16, 800 iterations)")
+                  "CPU-practical (4 x 16; DIP 1,200 iterations, S2S 800)")
       ->check(CLI::IsMember({"full", "fast"}))
       ->capture_default_str();
   command.add_option("--device", device, "auto (CUDA when available), cpu or cuda")
@@ -43,18 +43,24 @@ void DenoiserOptions::add_options(CLI::App& command) {
       ->check(CLI::PositiveNumber);
   command
       .add_option("--input-noise", input_noise,
-                  "DIP: sigma of the per-iteration input perturbation (full 1/30)")
+                  "DIP: sigma of the per-iteration input perturbation (full 1/30, fast 0)")
       ->check(CLI::NonNegativeNumber);
+  command
+      .add_option("--average", average,
+                  "Guided DIP: eq. (14)'s output average, 'uniform' (the paper's) or 'weighted' "
+                  "(each pixel's rate scaled by its loss weight, so let-go pixels keep their "
+                  "estimate; fast's default)")
+      ->check(CLI::IsMember({"uniform", "weighted"}));
   command.add_option("--pd", discard, "Guided S2S: p_d of eqs (17)-(18) (full 0.01, fast 1)")
       ->check(CLI::Range(0.0, 1.0));
   command.add_option("--dropout", dropout, "S2S: decoder dropout rate (default 0.3)")
       ->check(CLI::Range(0.0, 0.95));
   command
       .add_option("--kappa-w", kappa_w,
-                  "Guided DIP: warm-up iterations of eq. (16) (full 225, fast 450)")
+                  "Guided DIP: warm-up iterations of eq. (16) (225)")
       ->check(CLI::NonNegativeNumber);
   command
-      .add_option("--kappa-r", kappa_r, "Guided DIP: decay rate of eq. (16) (full 0.15, fast 0.05)")
+      .add_option("--kappa-r", kappa_r, "Guided DIP: decay rate of eq. (16) (0.15)")
       ->check(CLI::PositiveNumber);
   command.add_option("--kappa-c", kappa_c, "Guided DIP: weight floor of eq. (16) (0.02)")
       ->check(CLI::Range(0.0, 1.0));
@@ -86,6 +92,7 @@ denoise::NeuralParams DenoiserOptions::neural_params(denoise::NeuralMethod metho
   if (discard && denoise::is_guided(method)) p.masks.discard = *discard;
   if (dropout) p.dropout = *dropout;
   if (input_noise) p.input_perturbation = *input_noise;
+  if (average) p.weighted_averaging = *average == "weighted";
   if (kappa_w) p.decay.warmup = *kappa_w;
   if (kappa_r) p.decay.rate = *kappa_r;
   if (kappa_c) p.decay.floor = *kappa_c;

@@ -23,6 +23,7 @@ struct DenoiserOptions {
   std::uint64_t seed = 1;
   std::optional<int> iterations, predictions, levels, channels;
   std::optional<double> learning_rate, discard, dropout, input_noise;
+  std::optional<std::string> average;
   std::optional<int> kappa_w;
   std::optional<double> kappa_r, kappa_c, kappa_m;
   denoise::NlmParams nlm;

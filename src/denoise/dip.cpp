@@ -31,14 +31,23 @@ ImageF run_dip(const torch::Tensor& noisy, const ImageF* guidance, const NeuralP
     const torch::Tensor output = crop_to(net->forward(perturbed, {}), height, width);
     torch::Tensor residual = output - noisy;
     // eq. (15): mean of (residual·w)², w of eq. (16) (1 during the warm-up).
-    if (importance.defined() && i >= params.decay.warmup)
-      residual = residual * decayed_weight(i, importance, params.decay);
+    torch::Tensor weight;
+    if (importance.defined() && i >= params.decay.warmup) {
+      weight = decayed_weight(i, importance, params.decay);
+      residual = residual * weight;
+    }
     residual.pow(2).mean().backward();
     optimiser.step();
-    // eq. (14): exponential average of the outputs.
+    // eq. (14): exponential average of the outputs; with weighted averaging a pixel's rate is
+    // also scaled by its w, so a pixel let go keeps the estimate it had then.
     const torch::Tensor current = output.detach();
-    average = average.defined() ? params.averaging * average + (1.0 - params.averaging) * current
-                                : current;
+    if (!average.defined()) {
+      average = current;
+    } else {
+      torch::Tensor rate = torch::full({}, 1.0 - params.averaging, current.options());
+      if (params.weighted_averaging && weight.defined()) rate = rate * weight;
+      average = average + rate * (current - average);
+    }
     maybe_snapshot(params, i + 1, [&] { return average; });
     progress.advance();
   }

@@ -36,6 +36,11 @@ struct NeuralParams {
   double input_scale = 0.1;
   double input_perturbation = 1.0 / 30.0;  // σ of the per-iteration input noise
   double averaging = 0.99;                 // output EMA, eq. (14)
+  // Guided DIP: scale eq. (14)'s rate per pixel by w_dec, so the average stops following a
+  // pixel once its loss weight has decayed (per-pixel early stopping of the estimate as well as
+  // the loss; glint's addition, off in the paper's "full" settings). Without it the output of
+  // a small net drifts where nothing constrains it any more.
+  bool weighted_averaging = false;
   DecayParams decay;                       // guided loss weights, eq. (16)
   // Self2Self (§3.3).
   MaskParams masks;

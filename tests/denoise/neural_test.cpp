@@ -192,6 +192,31 @@ TEST(Neural, SameSeedSameResult) {
   EXPECT_EQ(a.values(), b.values());
 }
 
+// Weighted averaging (eq. (14) with the rate scaled by w_dec): once a pixel's weight is 0 its
+// estimate stays what it was, while pixels of weight 1 keep following the output.
+TEST(Neural, WeightedAveragingKeepsTheEstimateOfLetGoPixels) {
+  const SmokeImages s = smoke_images();
+  NeuralParams params = neural_preset(NeuralMethod::guided_dip, "fast");
+  params.net = UNetConfig{2, 8, 2};
+  params.device = "cpu";
+  params.weighted_averaging = true;
+  params.decay = DecayParams{0, 1000.0, 0.0};  // m = 0: w = 0.9^(1000 i) = 0 from step 1 on
+  params.iterations = 1;
+  const ImageF first = denoise_neural(s.noisy, &s.guidance, params);
+  params.iterations = 6;
+  const ImageF later = denoise_neural(s.noisy, &s.guidance, params);
+  double moved_clean = 0;
+  for (int c = 0; c < 3; ++c)
+    for (int y = 0; y < 32; ++y)
+      for (int x = 0; x < 32; ++x) {
+        if (s.guidance.at(x, y, 0) < 0.5f)
+          ASSERT_FLOAT_EQ(later.at(x, y, c), first.at(x, y, c)) << x << "," << y;
+        else
+          moved_clean += std::abs(later.at(x, y, c) - first.at(x, y, c));
+      }
+  EXPECT_GT(moved_clean, 0.0);
+}
+
 TEST(Neural, BadInputsAreErrors) {
   const SmokeImages s = smoke_images();
   NeuralParams params = neural_preset(NeuralMethod::guided_dip, "fast");
