@@ -95,14 +95,21 @@ ImageF inverted(const ImageF& image) {
   return inverse;
 }
 
+// PSNR of the whole image, its clean part and its noisy part.
+nlohmann::json psnr_parts(const ImageF& clean, const ImageF& result, const ImageF& noisy_mask,
+                          const ImageF& clean_mask) {
+  return {{"psnr", denoise::psnr(clean, result)},
+          {"psnr_clean", denoise::psnr(clean, result, &clean_mask)},
+          {"psnr_noisy", denoise::psnr(clean, result, &noisy_mask)}};
+}
+
 nlohmann::json quality(const ImageF& clean, const ImageF& result, const ImageF& noisy_mask,
                        const ImageF& clean_mask) {
-  return {{"psnr", denoise::psnr(clean, result)},
-          {"ssim", denoise::ssim(clean, result)},
-          {"psnr_clean", denoise::psnr(clean, result, &clean_mask)},
-          {"ssim_clean", denoise::ssim(clean, result, &clean_mask)},
-          {"psnr_noisy", denoise::psnr(clean, result, &noisy_mask)},
-          {"ssim_noisy", denoise::ssim(clean, result, &noisy_mask)}};
+  nlohmann::json values = psnr_parts(clean, result, noisy_mask, clean_mask);
+  values["ssim"] = denoise::ssim(clean, result);
+  values["ssim_clean"] = denoise::ssim(clean, result, &clean_mask);
+  values["ssim_noisy"] = denoise::ssim(clean, result, &noisy_mask);
+  return values;
 }
 
 // Mean, median, min and max of one metric over the images.
@@ -170,15 +177,13 @@ void run_eval(const EvalOptions& options) {
       // The quality of the running estimate over the iterations (DIP's Fig. 3-style curves).
       nlohmann::json trace = nlohmann::json::array();
       const auto score_estimate = [&](int iteration, const ImageF& estimate) {
-        trace.push_back({{"iteration", iteration},
-                         {"psnr", denoise::psnr(clean, estimate)},
-                         {"psnr_clean", denoise::psnr(clean, estimate, &clean_mask)},
-                         {"psnr_noisy", denoise::psnr(clean, estimate, &mask)}});
+        nlohmann::json point = psnr_parts(clean, estimate, mask, clean_mask);
+        point["iteration"] = iteration;
+        trace.push_back(std::move(point));
       };
-      const DenoiseRun run =
-          run_denoiser(method, options.denoiser, noisy,
-                       method_is_guided(method) ? &guidance : nullptr, score_estimate,
-                       options.trace_every);
+      const DenoiseRun run = run_denoiser(method, options.denoiser, noisy,
+                                          method_is_guided(method) ? &guidance : nullptr,
+                                          score_estimate, options.trace_every);
       nlohmann::json values = quality(clean, run.result, mask, clean_mask);
       if (!trace.empty()) values["trace"] = trace;
       values["seconds"] = run.stats.seconds;

@@ -55,12 +55,9 @@ void DenoiserOptions::add_options(CLI::App& command) {
       ->check(CLI::Range(0.0, 1.0));
   command.add_option("--dropout", dropout, "S2S: decoder dropout rate (default 0.3)")
       ->check(CLI::Range(0.0, 0.95));
-  command
-      .add_option("--kappa-w", kappa_w,
-                  "Guided DIP: warm-up iterations of eq. (16) (225)")
+  command.add_option("--kappa-w", kappa_w, "Guided DIP: warm-up iterations of eq. (16) (225)")
       ->check(CLI::NonNegativeNumber);
-  command
-      .add_option("--kappa-r", kappa_r, "Guided DIP: decay rate of eq. (16) (0.15)")
+  command.add_option("--kappa-r", kappa_r, "Guided DIP: decay rate of eq. (16) (0.15)")
       ->check(CLI::PositiveNumber);
   command.add_option("--kappa-c", kappa_c, "Guided DIP: weight floor of eq. (16) (0.02)")
       ->check(CLI::Range(0.0, 1.0));

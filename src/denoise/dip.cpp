@@ -44,9 +44,9 @@ ImageF run_dip(const torch::Tensor& noisy, const ImageF* guidance, const NeuralP
     if (!average.defined()) {
       average = current;
     } else {
-      torch::Tensor rate = torch::full({}, 1.0 - params.averaging, current.options());
-      if (params.weighted_averaging && weight.defined()) rate = rate * weight;
-      average = average + rate * (current - average);
+      torch::Tensor step = (current - average) * (1.0 - params.averaging);
+      if (params.weighted_averaging && weight.defined()) step = step * weight;
+      average = average + step;
     }
     maybe_snapshot(params, i + 1, [&] { return average; });
     progress.advance();

@@ -41,7 +41,7 @@ struct NeuralParams {
   // the loss; glint's addition, off in the paper's "full" settings). Without it the output of
   // a small net drifts where nothing constrains it any more.
   bool weighted_averaging = false;
-  DecayParams decay;                       // guided loss weights, eq. (16)
+  DecayParams decay;  // guided loss weights, eq. (16)
   // Self2Self (§3.3).
   MaskParams masks;
   double dropout = 0.3;   // decoder dropout rate before eq. (24)'s modulation

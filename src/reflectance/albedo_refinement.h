@@ -24,8 +24,8 @@ const char* albedo_average_name(AlbedoAverage average);       // "mean" | "media
 AlbedoAverage parse_albedo_average(const std::string& name);  // throws glint::Error
 
 // Eq. (7) over the voxel's observations (those seen from above the surface, at most
-// kMaxObservationsPerVoxel),
-// combined by `average`; nullopt when there is none or no light reaches the surface point.
+// kMaxObservationsPerVoxel), combined by `average`; nullopt when there is none or no light
+// reaches the surface point.
 // No allocation.
 std::optional<Eigen::Vector3f> refine_albedo(const Observation* observations, int count,
                                              const Eigen::Vector3f& position,

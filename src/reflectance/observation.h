@@ -27,11 +27,11 @@ struct NearestObservation {
 inline constexpr int kMaxObservationsPerVoxel = 255;
 
 // Adds `added` to the `count` observations in slots[0, capacity) (capacity <=
-// kMaxObservationsPerVoxel) and returns
-// the new count; `nearest` holds one entry per slot. When the voxel is full, of the most similar
-// pair (largest direction dot product over all pairs including the new one) the older
-// observation is dropped: newer ones were taken with better-converged geometry. O(capacity)
-// plus O(capacity) for each stored observation whose nearest one was dropped; no allocation.
+// kMaxObservationsPerVoxel) and returns the new count; `nearest` holds one entry per slot. When
+// the voxel is full, of the most similar pair (largest direction dot product over all pairs
+// including the new one) the older observation is dropped: newer ones were taken with
+// better-converged geometry. O(capacity) plus O(capacity) for each stored observation whose
+// nearest one was dropped; no allocation.
 int insert_observation(Observation* slots, NearestObservation* nearest, int count, int capacity,
                        const Observation& added);
 

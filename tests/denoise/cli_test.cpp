@@ -57,8 +57,7 @@ TEST_F(DenoiseCliTest, NoiseMapRunAndEval) {
   const CommandResult eval =
       glint("denoise eval --images " + path("clean.png") + " --crop 32" +
             " --methods nlm,s2s --iterations 4 --predictions 2 --levels 2 --channels 8" +
-            " --trace-every 2" +
-            " --report " + path("eval.json"));
+            " --trace-every 2 --report " + path("eval.json"));
   ASSERT_EQ(eval.exit_code, 0) << eval.output;
   const auto report = nlohmann::json::parse(std::ifstream(path("eval.json")));
   EXPECT_TRUE(report["summary"].contains("s2s"));
