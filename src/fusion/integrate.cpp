@@ -3,8 +3,11 @@
 #include <fmt/format.h>
 #include <tbb/enumerable_thread_specific.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
+#include <cstdint>
+#include <cstring>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -95,6 +98,57 @@ void allocate_blocks(TsdfVolume& volume, const ImageF& depth_m, const Intrinsics
                             params.block_capacity));
 }
 
+namespace {
+
+// One x-row of a block (kBlockSide voxels) as GCC vector lanes: one AVX2 register where the CPU
+// has AVX2 (the build's baseline is plain x86-64, so the kernel is compiled twice and picked at
+// load time), SSE pairs otherwise. Only the depth lookup runs lane by lane.
+using Floats = float __attribute__((vector_size(kBlockSide * sizeof(float))));
+using Ints = std::int32_t __attribute__((vector_size(kBlockSide * sizeof(std::int32_t))));
+
+struct RowConstants {
+  float fx, fy, cx, cy;
+  int width, height;
+  float depth_min, depth_max, truncation_m, truncation_per_depth, max_weight;
+  const float* depth;
+};
+
+// Fuses the row whose voxel centres are first + i * step (camera coordinates, i < kBlockSide);
+// fused_pixel[i] gets the pixel voxel i took its observation from, -1 where it took none.
+// (Vectors are not passed by value: their ABI differs between the two clones.)
+#if defined(__x86_64__)
+__attribute__((target_clones("arch=x86-64-v3", "default")))
+#endif
+void integrate_row(const RowConstants& k, const float first[3], const float step[3], float* sdf_m,
+                   float* weight, std::int32_t* fused_pixel) {
+  static_assert(kBlockSide == 8);
+  const Floats lane{0, 1, 2, 3, 4, 5, 6, 7};
+  const Floats x = first[0] + lane * step[0], y = first[1] + lane * step[1],
+               z = first[2] + lane * step[2];
+  const Floats inverse_z = 1.0f / z;
+  const Floats u = k.fx * x * inverse_z + k.cx, v = k.fy * y * inverse_z + k.cy;
+  // nearest_pixel() for every lane; outside lanes read pixel 0 and are masked off.
+  const Ints inside = (z > 0) & (u >= -0.5f) & (v >= -0.5f) & (u < float(k.width) - 0.5f) &
+                      (v < float(k.height) - 0.5f);
+  const Ints column = __builtin_convertvector(inside ? u + 0.5f : Floats{}, Ints);
+  const Ints row = __builtin_convertvector(inside ? v + 0.5f : Floats{}, Ints);
+  const Ints pixel = row * k.width + column;
+  Floats d;
+  for (int lane = 0; lane < kBlockSide; ++lane) d[lane] = k.depth[pixel[lane]];
+  Floats sdf, w;
+  std::memcpy(&sdf, sdf_m, sizeof(sdf));
+  std::memcpy(&w, weight, sizeof(w));
+  Ints fused;
+  fuse_voxel(d - z, k.truncation_m + k.truncation_per_depth * d, k.max_weight,
+             inside & (d >= k.depth_min) & (d <= k.depth_max), sdf, w, fused);
+  std::memcpy(sdf_m, &sdf, sizeof(sdf));
+  std::memcpy(weight, &w, sizeof(w));
+  const Ints result = fused ? pixel : -1;
+  std::memcpy(fused_pixel, &result, sizeof(result));
+}
+
+}  // namespace
+
 void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const ImageF& depth_m,
                       const ImageF& colour, const Intrinsics& intrinsics,
                       const Pose& camera_to_world) {
@@ -107,15 +161,18 @@ void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const Im
   const Eigen::Vector3f step_x = rotation.col(0) * voxel;
   const Eigen::Vector3f step_y = rotation.col(1) * voxel;
   const Eigen::Vector3f step_z = rotation.col(2) * voxel;
-  const float fx = static_cast<float>(intrinsics.fx), fy = static_cast<float>(intrinsics.fy);
-  const float cx = static_cast<float>(intrinsics.cx), cy = static_cast<float>(intrinsics.cy);
-  const float truncation_m = static_cast<float>(params.truncation_m);
-  const float truncation_per_depth = static_cast<float>(params.truncation_per_depth);
-  const float max_weight = params.max_weight;
-  const float depth_min = static_cast<float>(params.depth_min_m);
-  const float depth_max = static_cast<float>(params.depth_max_m);
-  const int width = depth_m.width(), height = depth_m.height();
-  const float* depth = depth_m.plane(0);
+  const RowConstants constants{static_cast<float>(intrinsics.fx),
+                               static_cast<float>(intrinsics.fy),
+                               static_cast<float>(intrinsics.cx),
+                               static_cast<float>(intrinsics.cy),
+                               depth_m.width(),
+                               depth_m.height(),
+                               static_cast<float>(params.depth_min_m),
+                               static_cast<float>(params.depth_max_m),
+                               static_cast<float>(params.truncation_m),
+                               static_cast<float>(params.truncation_per_depth),
+                               params.max_weight,
+                               depth_m.plane(0)};
   const bool with_colour = !colour.empty();
   const float* red_in = with_colour ? colour.plane(0) : nullptr;
   const float* green_in = with_colour ? colour.plane(1) : nullptr;
@@ -130,30 +187,24 @@ void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const Im
     float* red = volume.red(block);
     float* green = volume.green(block);
     float* blue = volume.blue(block);
-    int voxel_index = 0;
     for (int z = 0; z < kBlockSide; ++z) {
       for (int y = 0; y < kBlockSide; ++y) {
-        Eigen::Vector3f p =
+        const Eigen::Vector3f p =
             origin + step_z * static_cast<float>(z) + step_y * static_cast<float>(y);
-        for (int x = 0; x < kBlockSide; ++x, ++voxel_index, p += step_x) {
-          if (p.z() <= 0) continue;
-          const float inverse_z = 1.0f / p.z();
-          int px, py;
-          if (!nearest_pixel(fx * p.x() * inverse_z + cx, fy * p.y() * inverse_z + cy, width,
-                             height, px, py))
-            continue;
-          const int pixel = py * width + px;
-          const float d = depth[pixel];
-          if (!(d >= depth_min && d <= depth_max)) continue;
-          const float weight_before = weight[voxel_index];
-          if (!fuse_voxel(d - p.z(), truncation_m + truncation_per_depth * d, max_weight,
-                          sdf[voxel_index], weight[voxel_index]))
-            continue;
-          if (with_colour) {
-            red[voxel_index] = fuse_colour(red[voxel_index], weight_before, red_in[pixel]);
-            green[voxel_index] = fuse_colour(green[voxel_index], weight_before, green_in[pixel]);
-            blue[voxel_index] = fuse_colour(blue[voxel_index], weight_before, blue_in[pixel]);
-          }
+        const int first = (z * kBlockSide + y) * kBlockSide;
+        // The weights before this observation, for the colour average.
+        std::array<float, kBlockSide> weight_before;
+        if (with_colour) std::copy_n(weight + first, kBlockSide, weight_before.begin());
+        std::int32_t fused_pixel[kBlockSide];
+        integrate_row(constants, p.data(), step_x.data(), sdf + first, weight + first,
+                      fused_pixel);
+        if (!with_colour) continue;
+        for (int x = 0; x < kBlockSide; ++x) {
+          const int pixel = fused_pixel[x], voxel_index = first + x;
+          if (pixel < 0) continue;
+          red[voxel_index] = fuse_colour(red[voxel_index], weight_before[x], red_in[pixel]);
+          green[voxel_index] = fuse_colour(green[voxel_index], weight_before[x], green_in[pixel]);
+          blue[voxel_index] = fuse_colour(blue[voxel_index], weight_before[x], blue_in[pixel]);
         }
       }
     }

@@ -10,14 +10,16 @@ namespace glint::fusion {
 // Weighted running average of one voxel with one projective observation (Curless & Levoy 1996;
 // VoxelHashing §4.2): measured_sdf_m = depth - z along the optical axis. Observations more than
 // `truncation_m` behind the surface are ignored (returns false); in front they are clamped.
-GLINT_HOST_DEVICE inline bool fuse_voxel(float measured_sdf_m, float truncation_m, float max_weight,
-                                         float& sdf_m, float& weight) {
-  if (measured_sdf_m < -truncation_m) return false;
-  const float observation = measured_sdf_m < truncation_m ? measured_sdf_m : truncation_m;
-  const float total = weight + 1.0f;
-  sdf_m = (sdf_m * weight + observation) / total;
-  weight = total < max_weight ? total : max_weight;
-  return true;
+// Written without branches so that T may be a GCC vector of voxels (the lanes' `fused` mask is
+// then all-ones where the voxel took the observation); T = float is the scalar rule.
+template <class T, class Mask>
+GLINT_HOST_DEVICE inline void fuse_voxel(T measured_sdf_m, T truncation_m, float max_weight,
+                                         Mask valid, T& sdf_m, T& weight, Mask& fused) {
+  fused = valid & (measured_sdf_m >= -truncation_m);
+  const T observation = measured_sdf_m < truncation_m ? measured_sdf_m : truncation_m;
+  const T total = weight + 1.0f;
+  sdf_m = fused ? (sdf_m * weight + observation) / total : sdf_m;
+  weight = fused ? (total < max_weight ? total : T{} + max_weight) : weight;
 }
 
 // The same running average for a colour channel; `weight_before` is the voxel's weight before
