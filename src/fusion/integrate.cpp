@@ -196,8 +196,7 @@ void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const Im
         std::array<float, kBlockSide> weight_before;
         if (with_colour) std::copy_n(weight + first, kBlockSide, weight_before.begin());
         std::int32_t fused_pixel[kBlockSide];
-        integrate_row(constants, p.data(), step_x.data(), sdf + first, weight + first,
-                      fused_pixel);
+        integrate_row(constants, p.data(), step_x.data(), sdf + first, weight + first, fused_pixel);
         if (!with_colour) continue;
         for (int x = 0; x < kBlockSide; ++x) {
           const int pixel = fused_pixel[x], voxel_index = first + x;

@@ -26,15 +26,44 @@ class TsdfSampler {
   bool trilinear(const Eigen::Vector3f& p, float& sdf_m) {
     const Eigen::Vector3f v = p * inverse_voxel_;
     const int x = int(std::floor(v.x())), y = int(std::floor(v.y())), z = int(std::floor(v.z()));
-    const float fx = v.x() - x, fy = v.y() - y, fz = v.z() - z;
     float corner[8];
     for (int c = 0; c < 8; ++c) {
       if (voxel(x + (c & 1), y + ((c >> 1) & 1), z + ((c >> 2) & 1), corner[c]) != Sample::observed)
         return false;
     }
-    const auto lerp = [](float a, float b, float t) { return a + (b - a) * t; };
-    sdf_m = lerp(lerp(lerp(corner[0], corner[1], fx), lerp(corner[2], corner[3], fx), fy),
-                 lerp(lerp(corner[4], corner[5], fx), lerp(corner[6], corner[7], fx), fy), fz);
+    sdf_m = interpolate(corner, v.x() - x, v.y() - y, v.z() - z);
+    return true;
+  }
+
+  // The trilinear value at p and its central-difference gradient (per metre) with a step of one
+  // voxel, i.e. trilinear() at p and at p +- one voxel along each axis. The seven stencils share
+  // 32 voxels, each read once; false when any of them is unobserved.
+  bool trilinear_with_gradient(const Eigen::Vector3f& p, float& sdf_m, Eigen::Vector3f& gradient) {
+    const Eigen::Vector3f v = p * inverse_voxel_;
+    const int x = int(std::floor(v.x())), y = int(std::floor(v.y())), z = int(std::floor(v.z()));
+    // stencil[a][b][c] = voxel (x + a - 1, y + b - 1, z + c - 1): the 2x2x2 cell around p
+    // (indices 1, 2) and its six face neighbours (one index 0 or 3).
+    float stencil[4][4][4];
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b)
+        for (int c = 0; c < 4; ++c) {
+          const int outside = (a == 0 || a == 3) + (b == 0 || b == 3) + (c == 0 || c == 3);
+          if (outside > 1) continue;
+          if (voxel(x + a - 1, y + b - 1, z + c - 1, stencil[a][b][c]) != Sample::observed)
+            return false;
+        }
+    const float fx = v.x() - x, fy = v.y() - y, fz = v.z() - z;
+    const auto at = [&](int dx, int dy, int dz) {
+      float corner[8];
+      for (int k = 0; k < 8; ++k)
+        corner[k] = stencil[1 + dx + (k & 1)][1 + dy + ((k >> 1) & 1)][1 + dz + ((k >> 2) & 1)];
+      return interpolate(corner, fx, fy, fz);
+    };
+    sdf_m = at(0, 0, 0);
+    const float inverse_step = 0.5f * inverse_voxel_;
+    gradient = Eigen::Vector3f(at(1, 0, 0) - at(-1, 0, 0), at(0, 1, 0) - at(0, -1, 0),
+                               at(0, 0, 1) - at(0, 0, -1)) *
+               inverse_step;
     return true;
   }
 
@@ -64,6 +93,12 @@ class TsdfSampler {
   }
 
  private:
+  // Corners indexed by bits (x, y, z) = (1, 2, 4), at fractional position (fx, fy, fz).
+  static float interpolate(const float corner[8], float fx, float fy, float fz) {
+    const auto lerp = [](float a, float b, float t) { return a + (b - a) * t; };
+    return lerp(lerp(lerp(corner[0], corner[1], fx), lerp(corner[2], corner[3], fx), fy),
+                lerp(lerp(corner[4], corner[5], fx), lerp(corner[6], corner[7], fx), fy), fz);
+  }
   static int round_to_int(float value) { return static_cast<int>(std::floor(value + 0.5f)); }
 
   const TsdfVolume& volume_;

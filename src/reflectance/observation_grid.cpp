@@ -142,25 +142,17 @@ void ObservationGrid::allocate(const ImageF& depth_m, const Intrinsics& intrinsi
 }
 
 void ObservationGrid::refresh_surface(int v, const Eigen::Vector3f& centre,
-                                      fusion::TsdfSampler& sampler, float tsdf_voxel_m) {
+                                      fusion::TsdfSampler& sampler) {
   // Newton steps onto the zero level set along the (central-difference) SDF gradient: two from
   // the voxel centre, one from the previous surface point once there is one.
-  const float h = tsdf_voxel_m;
   const bool refine = has_surface_[v];
   Eigen::Vector3f p = refine ? position_[v] : centre, gradient = Eigen::Vector3f::Zero();
   bool found = false;
   for (int step = refine ? 1 : 0; step < 2; ++step) {
-    float sdf = 0, plus = 0, minus = 0;
-    if (!sampler.trilinear(p, sdf)) break;
-    bool ok = true;
-    for (int axis = 0; axis < 3 && ok; ++axis) {
-      Eigen::Vector3f offset = Eigen::Vector3f::Zero();
-      offset[axis] = h;
-      ok = sampler.trilinear(p + offset, plus) && sampler.trilinear(p - offset, minus);
-      gradient[axis] = (plus - minus) / (2 * h);
-    }
+    float sdf = 0;
+    if (!sampler.trilinear_with_gradient(p, sdf, gradient)) break;
     const float norm = gradient.norm();
-    if (!ok || !(norm > 0.1f)) break;
+    if (!(norm > 0.1f)) break;
     p -= sdf / (norm * norm) * gradient;
     found = true;
   }
@@ -193,7 +185,6 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
 
   // One slot per voxel of the frame's blocks; -1 = not observed.
   visible_.assign(frame_blocks_.size() * voxels_per_block_, VisibleVoxel{-1, -1});
-  const float tsdf_voxel_m = float(geometry.params().voxel_size_m);
   parallel_for(frame_blocks_.size(), [&](std::size_t slot) {
     const int block = frame_blocks_[slot];
     fusion::TsdfSampler sampler(geometry);  // its block cache serves the block's voxels
@@ -203,7 +194,7 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
       const int v = block * voxels_per_block_ + local;
       if (geometry_frame_[v] == 0 ||
           frame + 1 - geometry_frame_[v] >= params_.geometry_refresh_frames) {
-        refresh_surface(v, voxel_centre(first_voxel + offset), sampler, tsdf_voxel_m);
+        refresh_surface(v, voxel_centre(first_voxel + offset), sampler);
         geometry_frame_[v] = frame + 1;
       }
       if (!has_surface_[v]) continue;

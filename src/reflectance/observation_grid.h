@@ -113,8 +113,7 @@ class ObservationGrid {
   }
   void allocate(const ImageF& depth_m, const Intrinsics& intrinsics, const Pose& camera_to_world,
                 int frame);
-  void refresh_surface(int v, const Eigen::Vector3f& centre, fusion::TsdfSampler& sampler,
-                       float tsdf_voxel_m);
+  void refresh_surface(int v, const Eigen::Vector3f& centre, fusion::TsdfSampler& sampler);
 
   ObservationGridParams params_;
   int side_ = 2;

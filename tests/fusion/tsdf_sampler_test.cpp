@@ -1,0 +1,76 @@
+// TsdfSampler: trilinear reads and the shared-stencil value + gradient that the observation grid
+// uses to put its voxels on the surface.
+#include "fusion/tsdf_sampler.h"
+
+#include <gtest/gtest.h>
+
+#include "fusion_test_support.h"
+
+namespace glint::fusion {
+namespace {
+
+// 1 cm voxels (8 cm blocks).
+VolumeParams centimetre_voxels() {
+  VolumeParams params;
+  params.voxel_size_m = 0.01;
+  params.block_capacity = 20000;
+  return params;
+}
+
+TEST(TsdfSampler, GradientOfALinearFieldIsItsNormalAcrossBlockFaces) {
+  const Eigen::Vector3d normal = Eigen::Vector3d(0.3, -0.5, 0.8).normalized();
+  TsdfVolume volume(centimetre_voxels());
+  test::fill_analytic(
+      volume, [&](const Eigen::Vector3d& p) { return normal.dot(p) - 0.02; }, 0.5, 0.3);
+  TsdfSampler sampler(volume);
+  // Just inside a block corner (blocks are 8 cm), so the stencil spans eight blocks.
+  for (const Eigen::Vector3f& p :
+       {Eigen::Vector3f(0.0812f, 0.0795f, 0.0803f), Eigen::Vector3f(-0.0013f, 0.0437f, -0.0791f)}) {
+    float value = 0;
+    Eigen::Vector3f gradient;
+    ASSERT_TRUE(sampler.trilinear_with_gradient(p, value, gradient));
+    EXPECT_NEAR(value, normal.cast<float>().dot(p) - 0.02f, 1e-5f);
+    EXPECT_LT((gradient - normal.cast<float>()).norm(), 1e-4f) << gradient.transpose();
+  }
+}
+
+TEST(TsdfSampler, GradientIsTheCentralDifferenceOfTrilinearReads) {
+  const Eigen::Vector3d centre(0.01, -0.02, 0.03);
+  TsdfVolume volume(centimetre_voxels());
+  test::fill_analytic(
+      volume, [&](const Eigen::Vector3d& p) { return (p - centre).norm() - 0.2; }, 0.5, 0.3);
+  TsdfSampler sampler(volume);
+  const Eigen::Vector3f p(0.1734f, 0.0561f, 0.1049f);
+  float value = 0, expected = 0;
+  Eigen::Vector3f gradient;
+  ASSERT_TRUE(sampler.trilinear_with_gradient(p, value, gradient));
+  ASSERT_TRUE(sampler.trilinear(p, expected));
+  EXPECT_FLOAT_EQ(value, expected);
+  const float h = 0.01f;
+  for (int axis = 0; axis < 3; ++axis) {
+    Eigen::Vector3f step = Eigen::Vector3f::Zero();
+    step[axis] = h;
+    float plus = 0, minus = 0;
+    ASSERT_TRUE(sampler.trilinear(p + step, plus) && sampler.trilinear(p - step, minus));
+    EXPECT_NEAR(gradient[axis], (plus - minus) / (2 * h), 1e-3f) << axis;
+  }
+}
+
+TEST(TsdfSampler, AnUnobservedFaceNeighbourFailsTheGradientOnly) {
+  TsdfVolume volume(centimetre_voxels());
+  test::fill_analytic(
+      volume, [](const Eigen::Vector3d& p) { return p.z() - 0.013; }, 0.5, 0.3);
+  const Eigen::Vector3f p(0.0145f, 0.0155f, 0.0125f);  // cell (1, 1, 1)
+  // Voxel (3, 1, 1): in the +x face stencil, not in the cell's own eight.
+  const int block = volume.hash().find({0, 0, 0});
+  ASSERT_GE(block, 0);
+  volume.weight(block)[(1 * kBlockSide + 1) * kBlockSide + 3] = 0;
+  TsdfSampler sampler(volume);
+  float value = 0;
+  Eigen::Vector3f gradient;
+  EXPECT_TRUE(sampler.trilinear(p, value));
+  EXPECT_FALSE(sampler.trilinear_with_gradient(p, value, gradient));
+}
+
+}  // namespace
+}  // namespace glint::fusion
