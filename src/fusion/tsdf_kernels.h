@@ -9,12 +9,15 @@ namespace glint::fusion {
 
 // Weighted running average of one voxel with one projective observation (Curless & Levoy 1996;
 // VoxelHashing §4.2): measured_sdf_m = depth - z along the optical axis. Observations more than
-// `truncation_m` behind the surface are ignored (returns false); in front they are clamped.
-// Written without branches so that T may be a GCC vector of voxels (the lanes' `fused` mask is
-// then all-ones where the voxel took the observation); T = float is the scalar rule.
+// `truncation_m` behind the surface, and those not `valid`, are ignored (`fused` false); in
+// front they are clamped. Written without branches so that T may be a GCC vector of voxels
+// (Mask then holds all-ones lanes for true); T = float, Mask = bool is the scalar rule.
+// Arguments by reference: a vector by value changes the calling convention between the AVX2
+// clone and the baseline.
 template <class T, class Mask>
-GLINT_HOST_DEVICE inline void fuse_voxel(T measured_sdf_m, T truncation_m, float max_weight,
-                                         Mask valid, T& sdf_m, T& weight, Mask& fused) {
+GLINT_HOST_DEVICE inline void fuse_voxel(const T& measured_sdf_m, const T& truncation_m,
+                                         float max_weight, const Mask& valid, T& sdf_m, T& weight,
+                                         Mask& fused) {
   fused = valid & (measured_sdf_m >= -truncation_m);
   const T observation = measured_sdf_m < truncation_m ? measured_sdf_m : truncation_m;
   const T total = weight + 1.0f;
