@@ -100,31 +100,32 @@ void allocate_blocks(TsdfVolume& volume, const ImageF& depth_m, const Intrinsics
 
 namespace {
 
-// One x-row of a block (kBlockSide voxels) as GCC vector lanes: one AVX2 register where the CPU
-// has AVX2 (the build's baseline is plain x86-64, so the kernel is compiled twice and picked at
-// load time), SSE pairs otherwise. Only the depth lookup runs lane by lane.
+// A block is fused one x-row (kBlockSide voxels) at a time as GCC vector lanes: one AVX2
+// register where the CPU has AVX2 (the build's baseline is plain x86-64, so the block kernel is
+// compiled twice and picked at load time), SSE pairs otherwise. Only the depth lookup runs lane
+// by lane.
 using Floats = float __attribute__((vector_size(kBlockSide * sizeof(float))));
 using Ints = std::int32_t __attribute__((vector_size(kBlockSide * sizeof(std::int32_t))));
 
-struct RowConstants {
+struct FrameConstants {
   float fx, fy, cx, cy;
   int width, height;
   float depth_min, depth_max, truncation_m, truncation_per_depth, max_weight;
   const float* depth;
+  // One voxel step along the volume's x, y and z axes, in camera coordinates.
+  float step_x[3], step_y[3], step_z[3];
 };
 
-// Fuses the row whose voxel centres are first + i * step (camera coordinates, i < kBlockSide);
-// fused_pixel[i] gets the pixel voxel i took its observation from, -1 where it took none.
-// (Vectors are not passed by value: their ABI differs between the two clones.)
-#if defined(__x86_64__)
-__attribute__((target_clones("arch=x86-64-v3", "default")))
-#endif
-void integrate_row(const RowConstants& k, const float first[3], const float step[3], float* sdf_m,
-                   float* weight, std::int32_t* fused_pixel) {
+// Fuses the row whose voxel centres are first + i * step_x (camera coordinates,
+// i < kBlockSide); fused_pixel[i] gets the pixel voxel i took its observation from, -1 where it
+// took none. Inlined into both clones of integrate_block().
+[[gnu::always_inline]] inline void integrate_row(const FrameConstants& k, const float first[3],
+                                                 float* sdf_m, float* weight,
+                                                 std::int32_t* fused_pixel) {
   static_assert(kBlockSide == 8);
   const Floats lane{0, 1, 2, 3, 4, 5, 6, 7};
-  const Floats x = first[0] + lane * step[0], y = first[1] + lane * step[1],
-               z = first[2] + lane * step[2];
+  const Floats x = first[0] + lane * k.step_x[0], y = first[1] + lane * k.step_x[1],
+               z = first[2] + lane * k.step_x[2];
   const Floats inverse_z = 1.0f / z;
   const Floats u = k.fx * x * inverse_z + k.cx, v = k.fy * y * inverse_z + k.cy;
   // nearest_pixel() for every lane; outside lanes read pixel 0 and are masked off.
@@ -147,6 +148,25 @@ void integrate_row(const RowConstants& k, const float first[3], const float step
   std::memcpy(fused_pixel, &result, sizeof(result));
 }
 
+// Fuses the block whose voxel (0, 0, 0) is at `origin` (camera coordinates); fused_pixel has
+// one entry per voxel, as integrate_row(). (Vectors are not passed by value: their calling
+// convention differs between the two clones.)
+#if defined(__x86_64__)
+__attribute__((target_clones("arch=x86-64-v3", "default")))
+#endif
+void integrate_block(const FrameConstants& k, const float origin[3], float* sdf_m, float* weight,
+                     std::int32_t* fused_pixel) {
+  for (int z = 0; z < kBlockSide; ++z) {
+    for (int y = 0; y < kBlockSide; ++y) {
+      float first[3];
+      for (int axis = 0; axis < 3; ++axis)
+        first[axis] = origin[axis] + k.step_z[axis] * float(z) + k.step_y[axis] * float(y);
+      const int offset = (z * kBlockSide + y) * kBlockSide;
+      integrate_row(k, first, sdf_m + offset, weight + offset, fused_pixel + offset);
+    }
+  }
+}
+
 }  // namespace
 
 void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const ImageF& depth_m,
@@ -161,18 +181,21 @@ void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const Im
   const Eigen::Vector3f step_x = rotation.col(0) * voxel;
   const Eigen::Vector3f step_y = rotation.col(1) * voxel;
   const Eigen::Vector3f step_z = rotation.col(2) * voxel;
-  const RowConstants constants{static_cast<float>(intrinsics.fx),
-                               static_cast<float>(intrinsics.fy),
-                               static_cast<float>(intrinsics.cx),
-                               static_cast<float>(intrinsics.cy),
-                               depth_m.width(),
-                               depth_m.height(),
-                               static_cast<float>(params.depth_min_m),
-                               static_cast<float>(params.depth_max_m),
-                               static_cast<float>(params.truncation_m),
-                               static_cast<float>(params.truncation_per_depth),
-                               params.max_weight,
-                               depth_m.plane(0)};
+  const FrameConstants constants{static_cast<float>(intrinsics.fx),
+                                 static_cast<float>(intrinsics.fy),
+                                 static_cast<float>(intrinsics.cx),
+                                 static_cast<float>(intrinsics.cy),
+                                 depth_m.width(),
+                                 depth_m.height(),
+                                 static_cast<float>(params.depth_min_m),
+                                 static_cast<float>(params.depth_max_m),
+                                 static_cast<float>(params.truncation_m),
+                                 static_cast<float>(params.truncation_per_depth),
+                                 params.max_weight,
+                                 depth_m.plane(0),
+                                 {step_x.x(), step_x.y(), step_x.z()},
+                                 {step_y.x(), step_y.y(), step_y.z()},
+                                 {step_z.x(), step_z.y(), step_z.z()}};
   const bool with_colour = !colour.empty();
   const float* red_in = with_colour ? colour.plane(0) : nullptr;
   const float* green_in = with_colour ? colour.plane(1) : nullptr;
@@ -184,28 +207,21 @@ void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const Im
         rotation * volume.block_origin_m(volume.hash().block(block)).cast<float>() + translation;
     float* sdf = volume.sdf_m(block);
     float* weight = volume.weight(block);
+    // The weights before this observation, for the colour average.
+    std::array<float, kVoxelsPerBlock> weight_before;
+    if (with_colour) std::copy_n(weight, kVoxelsPerBlock, weight_before.begin());
+    std::array<std::int32_t, kVoxelsPerBlock> fused_pixel;
+    integrate_block(constants, origin.data(), sdf, weight, fused_pixel.data());
+    if (!with_colour) return;
     float* red = volume.red(block);
     float* green = volume.green(block);
     float* blue = volume.blue(block);
-    for (int z = 0; z < kBlockSide; ++z) {
-      for (int y = 0; y < kBlockSide; ++y) {
-        const Eigen::Vector3f p =
-            origin + step_z * static_cast<float>(z) + step_y * static_cast<float>(y);
-        const int first = (z * kBlockSide + y) * kBlockSide;
-        // The weights before this observation, for the colour average.
-        std::array<float, kBlockSide> weight_before;
-        if (with_colour) std::copy_n(weight + first, kBlockSide, weight_before.begin());
-        std::int32_t fused_pixel[kBlockSide];
-        integrate_row(constants, p.data(), step_x.data(), sdf + first, weight + first, fused_pixel);
-        if (!with_colour) continue;
-        for (int x = 0; x < kBlockSide; ++x) {
-          const int pixel = fused_pixel[x], voxel_index = first + x;
-          if (pixel < 0) continue;
-          red[voxel_index] = fuse_colour(red[voxel_index], weight_before[x], red_in[pixel]);
-          green[voxel_index] = fuse_colour(green[voxel_index], weight_before[x], green_in[pixel]);
-          blue[voxel_index] = fuse_colour(blue[voxel_index], weight_before[x], blue_in[pixel]);
-        }
-      }
+    for (int v = 0; v < kVoxelsPerBlock; ++v) {
+      const int pixel = fused_pixel[v];
+      if (pixel < 0) continue;
+      red[v] = fuse_colour(red[v], weight_before[v], red_in[pixel]);
+      green[v] = fuse_colour(green[v], weight_before[v], green_in[pixel]);
+      blue[v] = fuse_colour(blue[v], weight_before[v], blue_in[pixel]);
     }
   });
 }
