@@ -3,7 +3,7 @@
 # noise sigma 50/255 in random blobs over ~30 % of each image (protocol seed 2022), all five
 # methods; plus the noise-map AUCs on procedural step/gradient images (sigma 50, 25, 15).
 # JSON in build/bench/. CROP and METHODS size the `full` configuration for a CPU: it takes
-# ~6 minutes per DIP run at 64x64 on 2 cores (S2S's 150k steps are a GPU job at any size):
+# 4-5 minutes per DIP run at 64x64 on 2 quiet cores (S2S's 150k steps are a GPU job at any size):
 #   scripts/eval-denoise.sh GLINT DATA 6 full 64 dip,guided-dip
 #   scripts/eval-denoise.sh GLINT DATA [COUNT] [CONFIG] [CROP] [METHODS]
 set -euo pipefail
