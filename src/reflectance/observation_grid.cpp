@@ -3,6 +3,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -20,6 +21,14 @@ std::unique_ptr<T[], void (*)(void*)> zeroed_pool(std::size_t count) {
   void* memory = std::calloc(count, sizeof(T));
   if (!memory) throw Error("observation grid", "", "cannot reserve the voxel pools");
   return {static_cast<T*>(memory), std::free};
+}
+
+// Asks for the cache lines of [p, p + bytes) ahead of use.
+void prefetch_lines(const void* p, std::size_t bytes) {
+  constexpr std::size_t kLine = 64;
+  const auto* first = static_cast<const char*>(p);
+  for (std::size_t offset = 0; offset < bytes; offset += kLine) __builtin_prefetch(first + offset);
+  if (bytes > 0) __builtin_prefetch(first + bytes - 1);
 }
 
 Eigen::Vector3i floor_div(const Eigen::Vector3i& v, int side) {
@@ -48,6 +57,22 @@ std::size_t voxel_capacity(const ObservationGridParams& params) {
 
 }  // namespace
 
+void ObservationGrid::prefetch_observations(int v) const {
+  const std::size_t first_slot = std::size_t(v) * params_.observations_per_voxel;
+  prefetch_lines(observations_.get() + first_slot, observation_count_[v] * sizeof(Observation));
+  prefetch_lines(nearest_.get() + first_slot, observation_count_[v] * sizeof(NearestObservation));
+}
+
+void ObservationGrid::prefetch_voxel_state(int block) const {
+  const std::size_t first = std::size_t(block) * voxels_per_block_;
+  const std::size_t voxels = voxels_per_block_;
+  prefetch_lines(next_refresh_frame_.get() + first, voxels * sizeof(int));
+  prefetch_lines(has_surface_.get() + first, voxels * sizeof(bool));
+  prefetch_lines(position_.get() + first, voxels * sizeof(Eigen::Vector3f));
+  prefetch_lines(normal_.get() + first, voxels * sizeof(Eigen::Vector3f));
+  prefetch_lines(observation_count_.get() + first, voxels * sizeof(std::uint8_t));
+}
+
 ObservationGrid::ObservationGrid(const ObservationGridParams& params)
     : params_(params),
       side_(block_side(params)),
@@ -59,7 +84,8 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
       position_(zeroed_pool<Eigen::Vector3f>(1)),
       normal_(zeroed_pool<Eigen::Vector3f>(1)),
       refined_kd_(zeroed_pool<Eigen::Vector3f>(1)),
-      geometry_frame_(zeroed_pool<int>(1)),
+      next_refresh_frame_(zeroed_pool<int>(1)),
+      surface_misses_(zeroed_pool<std::uint8_t>(1)),
       has_surface_(zeroed_pool<bool>(1)),
       segment_(zeroed_pool<std::int32_t>(1)),
       segment_confidence_(zeroed_pool<std::int16_t>(1)),
@@ -69,6 +95,10 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
                 "must be in 1.." + std::to_string(kMaxObservationsPerVoxel));
   if (params.allocation_stride_px < 1)
     throw Error("observation grid", "allocation_stride_px", "must be >= 1");
+  if (params.geometry_refresh_frames < 1)
+    throw Error("observation grid", "geometry_refresh_frames", "must be >= 1");
+  if (params.surface_retry_doublings < 0 || params.surface_retry_doublings > 8)
+    throw Error("observation grid", "surface_retry_doublings", "must be in 0..8");
   const std::size_t voxels = hash_.capacity() * voxels_per_block_;
   observations_ = zeroed_pool<Observation>(voxels * params.observations_per_voxel);
   nearest_ = zeroed_pool<NearestObservation>(voxels * params.observations_per_voxel);
@@ -76,7 +106,8 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
   position_ = zeroed_pool<Eigen::Vector3f>(voxels);
   normal_ = zeroed_pool<Eigen::Vector3f>(voxels);
   refined_kd_ = zeroed_pool<Eigen::Vector3f>(voxels);
-  geometry_frame_ = zeroed_pool<int>(voxels);
+  next_refresh_frame_ = zeroed_pool<int>(voxels);
+  surface_misses_ = zeroed_pool<std::uint8_t>(voxels);
   has_surface_ = zeroed_pool<bool>(voxels);
   segment_ = zeroed_pool<std::int32_t>(voxels);
   segment_confidence_ = zeroed_pool<std::int16_t>(voxels);
@@ -141,7 +172,7 @@ void ObservationGrid::allocate(const ImageF& depth_m, const Intrinsics& intrinsi
     frame_blocks_.insert(frame_blocks_.end(), mine.begin(), mine.end());
 }
 
-void ObservationGrid::refresh_surface(int v, const Eigen::Vector3f& centre,
+void ObservationGrid::refresh_surface(int v, const Eigen::Vector3f& centre, int frame,
                                       fusion::TsdfSampler& sampler) {
   // Newton steps onto the zero level set along the (central-difference) SDF gradient: two from
   // the voxel centre, one from the previous surface point once there is one.
@@ -160,6 +191,12 @@ void ObservationGrid::refresh_surface(int v, const Eigen::Vector3f& centre,
   const float half = 0.5f * float(params_.voxel_size_m);
   found = found && ((p - centre).cwiseAbs().maxCoeff() <= half * 1.001f);
   has_surface_[v] = found;
+  // Most voxels without surface are empty space beside it in a block the surface crosses, and
+  // stay so: retrying them every few frames was most of the observation stage's TSDF reads.
+  const int misses =
+      found ? 0 : std::min(surface_misses_[v] + 1, params_.surface_retry_doublings + 1);
+  surface_misses_[v] = std::uint8_t(misses);
+  next_refresh_frame_[v] = frame + (params_.geometry_refresh_frames << std::max(0, misses - 1));
   if (!found) return;
   position_[v] = p;
   normal_[v] = gradient.normalized();
@@ -185,43 +222,64 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
 
   // One slot per voxel of the frame's blocks; -1 = not observed.
   visible_.assign(frame_blocks_.size() * voxels_per_block_, VisibleVoxel{-1, -1});
-  parallel_for(frame_blocks_.size(), [&](std::size_t slot) {
+  // A block's voxels go in two passes: the first refreshes surfaces, tests visibility and
+  // prefetches the observation slots of the visible voxels; the second inserts. Insertion reads
+  // every stored direction of a voxel (~1 KB), so the misses of a whole chunk then overlap
+  // instead of stalling voxel after voxel. The next block's per-voxel state is prefetched too:
+  // the blocks of a frame lie scattered in the pools.
+  struct Seen {
+    int local, x, y;
+    Eigen::Vector3f direction;
+  };
+  constexpr int kChunk = 64;
+  const std::size_t blocks = frame_blocks_.size();
+  parallel_for(blocks, [&](std::size_t slot) {
     const int block = frame_blocks_[slot];
+    prefetch_voxel_state(frame_blocks_[slot + 1 < blocks ? slot + 1 : slot]);
     fusion::TsdfSampler sampler(geometry);  // its block cache serves the block's voxels
     const Eigen::Vector3i first_voxel = hash_.block(block) * side_;
-    for (int local = 0; local < voxels_per_block_; ++local) {
-      const Eigen::Vector3i offset(local % side_, (local / side_) % side_, local / (side_ * side_));
-      const int v = block * voxels_per_block_ + local;
-      if (geometry_frame_[v] == 0 ||
-          frame + 1 - geometry_frame_[v] >= params_.geometry_refresh_frames) {
-        refresh_surface(v, voxel_centre(first_voxel + offset), sampler);
-        geometry_frame_[v] = frame + 1;
+    std::array<Seen, kChunk> seen;
+    for (int chunk = 0; chunk < voxels_per_block_; chunk += kChunk) {
+      int seen_count = 0;
+      for (int local = chunk; local < std::min(chunk + kChunk, voxels_per_block_); ++local) {
+        const Eigen::Vector3i offset(local % side_, (local / side_) % side_,
+                                     local / (side_ * side_));
+        const int v = block * voxels_per_block_ + local;
+        if (frame >= next_refresh_frame_[v])
+          refresh_surface(v, voxel_centre(first_voxel + offset), frame, sampler);
+        if (!has_surface_[v]) continue;
+        // Visibility: in the image, in front, facing the camera, not occluded.
+        const Eigen::Vector3f q = rotation * position_[v] + translation;
+        if (!(q.z() > 0)) continue;
+        const float u = float(intrinsics.fx) * q.x() / q.z() + float(intrinsics.cx);
+        const float w = float(intrinsics.fy) * q.y() / q.z() + float(intrinsics.cy);
+        const int x = int(std::lround(u)), y = int(std::lround(w));
+        if (x < 0 || y < 0 || x >= width || y >= height) continue;
+        const float measured = depth_m.at(x, y, 0);
+        const float tolerance = float(params_.depth_tolerance_m) +
+                                float(params_.depth_tolerance_sigmas) * kinect_axial_noise_m(q.z());
+        if (!(measured > 0) || std::fabs(measured - q.z()) > tolerance) continue;
+        const Eigen::Vector3f direction = (camera_centre - position_[v]).normalized();
+        if (normal_[v].dot(direction) < float(params_.min_view_cosine)) continue;
+        prefetch_observations(v);
+        seen[seen_count++] = {local, x, y, direction};
       }
-      if (!has_surface_[v]) continue;
-      // Visibility: in the image, in front, facing the camera, not occluded.
-      const Eigen::Vector3f q = rotation * position_[v] + translation;
-      if (!(q.z() > 0)) continue;
-      const float u = float(intrinsics.fx) * q.x() / q.z() + float(intrinsics.cx);
-      const float w = float(intrinsics.fy) * q.y() / q.z() + float(intrinsics.cy);
-      const int x = int(std::lround(u)), y = int(std::lround(w));
-      if (x < 0 || y < 0 || x >= width || y >= height) continue;
-      const float measured = depth_m.at(x, y, 0);
-      const float tolerance = float(params_.depth_tolerance_m) +
-                              float(params_.depth_tolerance_sigmas) * kinect_axial_noise_m(q.z());
-      if (!(measured > 0) || std::fabs(measured - q.z()) > tolerance) continue;
-      const Eigen::Vector3f direction = (camera_centre - position_[v]).normalized();
-      if (normal_[v].dot(direction) < float(params_.min_view_cosine)) continue;
-      Observation observation;
-      observation.colour =
-          Eigen::Vector3f(colour.at(x, y, 0), colour.at(x, y, 1), colour.at(x, y, 2)) *
-          inverse_exposure;
-      observation.direction = direction;
-      observation.frame = std::uint32_t(frame);
-      const std::size_t first_slot = std::size_t(v) * capacity;
-      observation_count_[v] = std::uint8_t(
-          insert_observation(observations_.get() + first_slot, nearest_.get() + first_slot,
-                             observation_count_[v], capacity, observation));
-      visible_[slot * voxels_per_block_ + local] = {v, y * width + x};
+      for (int i = 0; i < seen_count; ++i) {
+        const Seen& voxel = seen[i];
+        const int v = block * voxels_per_block_ + voxel.local;
+        Observation observation;
+        observation.colour =
+            Eigen::Vector3f(colour.at(voxel.x, voxel.y, 0), colour.at(voxel.x, voxel.y, 1),
+                            colour.at(voxel.x, voxel.y, 2)) *
+            inverse_exposure;
+        observation.direction = voxel.direction;
+        observation.frame = std::uint32_t(frame);
+        const std::size_t first_slot = std::size_t(v) * capacity;
+        observation_count_[v] = std::uint8_t(
+            insert_observation(observations_.get() + first_slot, nearest_.get() + first_slot,
+                               observation_count_[v], capacity, observation));
+        visible_[slot * voxels_per_block_ + voxel.local] = {v, voxel.y * width + voxel.x};
+      }
     }
   });
   std::erase_if(visible_, [](const VisibleVoxel& seen) { return seen.voxel < 0; });

@@ -6,7 +6,8 @@
 // Per voxel it keeps:
 //  - a surface point and normal, taken from the fused TSDF: the voxel centre moved onto the zero
 //    level set along the SDF gradient (two Newton steps), refreshed every few frames while the
-//    geometry converges; voxels the surface does not pass through have none;
+//    geometry converges; voxels the surface does not pass through have none, and are retried
+//    ever less often;
 //  - at most `observations_per_voxel` (m = 30) observations: linear radiance (pixel / exposure)
 //    and the unit voxel-to-camera direction, with the most-similar-pair replacement of
 //    reflectance/observation.h;
@@ -49,6 +50,9 @@ struct ObservationGridParams {
   double depth_tolerance_sigmas = 3;  // ... this many Kinect sigma(z) (render/sensor.h)
   double min_view_cosine = 0.1;       // normal . direction of an accepted observation
   int geometry_refresh_frames = 8;    // surface point / normal recomputed this often
+  // A voxel without surface is retried after geometry_refresh_frames, then twice, four times ...
+  // as long, doubling at most this many times.
+  int surface_retry_doublings = 3;
 };
 
 // One voxel seen in the current frame: its pool index and the pixel it projects to.
@@ -85,6 +89,8 @@ class ObservationGrid {
   const Observation* observations(int v) const {
     return observations_.get() + std::size_t(v) * params_.observations_per_voxel;
   }
+  // Asks for voxel v's stored observations (about 1 KB, usually a cache miss) ahead of use.
+  void prefetch_observations(int v) const;
   std::int32_t& segment(int v) { return segment_[v]; }
   std::int32_t segment(int v) const { return segment_[v]; }
   std::int16_t& segment_confidence(int v) { return segment_confidence_[v]; }
@@ -113,7 +119,10 @@ class ObservationGrid {
   }
   void allocate(const ImageF& depth_m, const Intrinsics& intrinsics, const Pose& camera_to_world,
                 int frame);
-  void refresh_surface(int v, const Eigen::Vector3f& centre, fusion::TsdfSampler& sampler);
+  void refresh_surface(int v, const Eigen::Vector3f& centre, int frame,
+                       fusion::TsdfSampler& sampler);
+  // Prefetches the per-voxel state collect() reads first for the voxels of `block`.
+  void prefetch_voxel_state(int block) const;
 
   ObservationGridParams params_;
   int side_ = 2;
@@ -127,7 +136,8 @@ class ObservationGrid {
   Pool<NearestObservation> nearest_;  // parallel to observations_
   Pool<std::uint8_t> observation_count_;
   Pool<Eigen::Vector3f> position_, normal_, refined_kd_;
-  Pool<int> geometry_frame_;  // frame of the last surface refresh + 1 (0 = never tried)
+  Pool<int> next_refresh_frame_;       // frame of the next surface refresh
+  Pool<std::uint8_t> surface_misses_;  // refreshes in a row that found no surface
   Pool<bool> has_surface_;
   Pool<std::int32_t> segment_;
   Pool<std::int16_t> segment_confidence_;

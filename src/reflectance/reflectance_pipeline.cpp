@@ -27,16 +27,21 @@ ReflectancePipeline::ReflectancePipeline(const Intrinsics& intrinsics,
 }
 
 void ReflectancePipeline::refine_albedo_of_visible() {
-  const std::vector<VisibleVoxel>& visible = grid_.visible();
-  parallel_for(visible.size(), [&](std::size_t i) {
-    const int v = visible[i].voxel;
-    if (grid_.has_refined_kd(v) && (v + frame_) % params_.albedo_refresh_frames != 0) return;
+  // Due: voxels never refined, and those whose turn in the refresh cycle it is.
+  albedo_due_.clear();
+  for (const VisibleVoxel& seen : grid_.visible())
+    if (!grid_.has_refined_kd(seen.voxel) ||
+        (seen.voxel + frame_) % params_.albedo_refresh_frames == 0)
+      albedo_due_.push_back(seen.voxel);
+  parallel_for(albedo_due_.size(), [&](std::size_t i) {
+    if (i + 1 < albedo_due_.size()) grid_.prefetch_observations(albedo_due_[i + 1]);
+    const int v = albedo_due_[i];
     const SegmentMaterial* material = specular_.material(grid_.segment(v));
     if (!material) return;
     const auto kd = refine_albedo(grid_.observations(v), grid_.observation_count(v),
                                   grid_.position(v), grid_.normal(v), lights_, material->ward.ks,
                                   material->ward.alpha, params_.albedo_average);
-    // Each voxel is written by one iteration only: the visible list holds it once.
+    // Each voxel is written by one iteration only: the due list holds it once.
     grid_.has_refined_kd(v) = kd.has_value();
     if (kd) grid_.refined_kd(v) = kd->cwiseMax(0.0f).cwiseMin(1.0f);
   });

@@ -88,6 +88,7 @@ class ReflectancePipeline {
   SpecularEstimator specular_;
   std::vector<render::PointLight> lights_;
   StageTimings timings_;
+  std::vector<int> albedo_due_;  // scratch of refine_albedo_of_visible()
   int frame_ = 0;
 };
 

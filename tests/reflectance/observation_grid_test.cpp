@@ -98,7 +98,32 @@ TEST(ObservationGrid, ObservationsAccumulateUpToTheCapacity) {
   EXPECT_GT(full, 20);
 }
 
+TEST(ObservationGrid, VoxelsWithoutSurfaceAreRetriedEverLessOften) {
+  // Frames 0-8 see the wall before any geometry is fused: its voxels find no surface at frame 0
+  // and at their first retry (frame 8); the second retry waits twice as long (frame 24).
+  fusion::TsdfVolume geometry(geometry_params());
+  fusion::VisibleBlocks blocks;
+  Wall wall;
+  ObservationGrid grid(grid_params());
+  ASSERT_EQ(grid.params().geometry_refresh_frames, 8);
+  for (int frame = 0; frame <= 24; ++frame) {
+    if (frame == 9)
+      fusion::integrate(geometry, wall.depth, wall.colour, kCamera, Pose::Identity(), blocks);
+    const auto& visible =
+        grid.collect(wall.depth, wall.colour, kCamera, Pose::Identity(), 1.0f, geometry, frame);
+    if (frame < 24)
+      EXPECT_TRUE(visible.empty()) << "frame " << frame;
+    else
+      EXPECT_GT(visible.size(), 50u);
+  }
+}
+
 TEST(ObservationGrid, BadInputsAndExhaustion) {
+  EXPECT_NE(std::string(test::error_of([] {
+                          ObservationGrid(ObservationGridParams{.surface_retry_doublings = 9});
+                        }).what())
+                .find("surface_retry_doublings"),
+            std::string::npos);
   EXPECT_NE(std::string(test::error_of([] {
                           ObservationGrid(ObservationGridParams{.voxel_size_m = 0.03});
                         }).what())
