@@ -38,7 +38,7 @@ FrameResult FusionPipeline::process(const io::RgbdFrame& frame) {
     allocate_blocks(volume_, frame.depth_m, intrinsics_, result.camera_to_world, visible_);
     const double allocate_ms = watch.elapsed_ms();
     integrate_blocks(volume_, visible_, frame.depth_m,
-                     params_.integrate_colour ? frame.colour : ImageF(), intrinsics_,
+                     volume_.has_colour() ? frame.colour : ImageF(), intrinsics_,
                      result.camera_to_world);
     timings_.add("integrate", watch.elapsed_ms());
     timings_.add("allocate_blocks", allocate_ms);

@@ -20,9 +20,6 @@ struct FusionParams {
   TrackingParams tracking;
   // Use each frame's ground-truth pose instead of tracking (frames without one are errors).
   bool use_ground_truth_poses = false;
-  // Fuse the colour into the TSDF (mesh colours). The reflectance pipeline keeps its colours in
-  // the observation grid and turns this off: 2 of the 5 per-voxel arrays are then touched.
-  bool integrate_colour = true;
 };
 
 struct FrameResult {

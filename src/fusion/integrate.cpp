@@ -181,6 +181,8 @@ void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const Im
                       const ImageF& colour, const Intrinsics& intrinsics,
                       const Pose& camera_to_world) {
   require_same_size(depth_m, colour, intrinsics);
+  if (!colour.empty() && !volume.has_colour())
+    throw Error("TSDF volume", "colour", "keeps no colour (VolumeParams::colour is off)");
   const VolumeParams& params = volume.params();
   const Pose world_to_camera = camera_to_world.inverse();
   const Eigen::Matrix3f rotation = world_to_camera.linear().cast<float>();

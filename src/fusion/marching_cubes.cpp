@@ -41,6 +41,7 @@ class BlockNeighbourhood {
     return true;
   }
   Eigen::Vector3f colour(int x, int y, int z) const {
+    if (!volume_.has_colour()) return Eigen::Vector3f::Zero();
     const int block = blocks_[(x >> 3) | ((y >> 3) << 1) | ((z >> 3) << 2)];
     const int voxel = voxel_in_block(x, y, z);
     return {volume_.red(block)[voxel], volume_.green(block)[voxel], volume_.blue(block)[voxel]};

@@ -67,8 +67,10 @@ class TsdfSampler {
     return true;
   }
 
-  // Colour of the nearest voxel (call after an observed sample there).
+  // Colour of the nearest voxel (call after an observed sample there); black in a volume that
+  // keeps no colour.
   Eigen::Vector3f nearest_colour(const Eigen::Vector3f& p) {
+    if (!volume_.has_colour()) return Eigen::Vector3f::Zero();
     const Eigen::Vector3f v = p * inverse_voxel_;
     float unused;
     const int x = round_to_int(v.x()), y = round_to_int(v.y()), z = round_to_int(v.z());

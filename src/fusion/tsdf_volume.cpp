@@ -10,9 +10,9 @@ TsdfVolume::TsdfVolume(const VolumeParams& params)
       // new T[] without () leaves the pools uninitialised: pages are committed on first use.
       sdf_m_(new float[params.block_capacity * kVoxelsPerBlock]),
       weight_(new float[params.block_capacity * kVoxelsPerBlock]),
-      red_(new float[params.block_capacity * kVoxelsPerBlock]),
-      green_(new float[params.block_capacity * kVoxelsPerBlock]),
-      blue_(new float[params.block_capacity * kVoxelsPerBlock]),
+      red_(params.colour ? new float[params.block_capacity * kVoxelsPerBlock] : nullptr),
+      green_(params.colour ? new float[params.block_capacity * kVoxelsPerBlock] : nullptr),
+      blue_(params.colour ? new float[params.block_capacity * kVoxelsPerBlock] : nullptr),
       last_visible_(new std::atomic<int>[params.block_capacity]) {
   for (std::size_t b = 0; b < params.block_capacity; ++b) last_visible_[b].store(-1);
 }
@@ -23,9 +23,11 @@ int TsdfVolume::allocate(const Eigen::Vector3i& block) {
     const int b = insertion.index;
     std::fill_n(sdf_m(b), kVoxelsPerBlock, 0.0f);
     std::fill_n(weight(b), kVoxelsPerBlock, 0.0f);
-    std::fill_n(red(b), kVoxelsPerBlock, 0.0f);
-    std::fill_n(green(b), kVoxelsPerBlock, 0.0f);
-    std::fill_n(blue(b), kVoxelsPerBlock, 0.0f);
+    if (has_colour()) {
+      std::fill_n(red(b), kVoxelsPerBlock, 0.0f);
+      std::fill_n(green(b), kVoxelsPerBlock, 0.0f);
+      std::fill_n(blue(b), kVoxelsPerBlock, 0.0f);
+    }
   }
   return insertion.index;
 }

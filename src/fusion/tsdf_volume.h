@@ -6,7 +6,7 @@
 //
 // Voxel values: sdf_m, signed distance along the viewing ray in metres (positive in front of the
 // surface), clamped to the truncation band; weight, number of fused observations (saturating);
-// red, green, blue, weighted mean linear colour.
+// red, green, blue, weighted mean linear colour (only in volumes that keep colour).
 #include <Eigen/Core>
 #include <atomic>
 #include <memory>
@@ -41,6 +41,9 @@ class TsdfVolume {
   // Inserts the block (zeroed) if absent; thread-safe against concurrent calls. Returns its
   // pool index or VoxelBlockHash::kPoolFull.
   int allocate(const Eigen::Vector3i& block);
+
+  // Whether the volume keeps colour (VolumeParams::colour); red(), green(), blue() need it.
+  bool has_colour() const { return params_.colour; }
 
   float* sdf_m(int block) { return sdf_m_.get() + voxel_offset(block); }
   float* weight(int block) { return weight_.get() + voxel_offset(block); }

@@ -30,6 +30,7 @@ ExtractedHemiImages extract_hemi_images(const std::string& sequence_folder,
   geometry.volume.voxel_size_m = params.geometry_voxel_m;
   geometry.use_ground_truth_poses = true;
   geometry.volume.block_capacity = params.geometry_block_capacity;
+  geometry.volume.colour = false;  // the observation grid keeps the colours
   fusion::FusionPipeline fusion(sequence.intrinsics, geometry);
   ObservationGrid grid(params.observations);
   SegmentMap segments;

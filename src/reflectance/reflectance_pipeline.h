@@ -26,8 +26,7 @@ namespace glint::reflectance {
 struct ReflectanceParams {
   // Depth up to 6 m (the fusion default is 4 m): the paper's synthetic scenes are seen from 4 m
   // away, so their far objects lie at 5-5.5 m.
-  fusion::FusionParams geometry{
-      .volume = {.depth_max_m = 6.0}, .tracking = {}, .integrate_colour = false};
+  fusion::FusionParams geometry{.volume = {.depth_max_m = 6.0, .colour = false}, .tracking = {}};
   ObservationGridParams observations;
   DepthSegmentationParams segmentation;  // min_segment_px at full resolution
   // The depth segmentation runs on the depth image halved this many times (KinectFusion's

@@ -71,6 +71,31 @@ TEST(Integrate, RepeatedFramesAverageAndColourFollows) {
   EXPECT_NEAR(volume.red(block)[voxel], 0.5, 1e-6);
 }
 
+TEST(Integrate, AVolumeWithoutColourFusesTheSameDistancesAndRefusesColour) {
+  VolumeParams params = plane_params();
+  TsdfVolume with_colour(params);
+  params.colour = false;
+  TsdfVolume without_colour(params);
+  ASSERT_FALSE(without_colour.has_colour());
+  VisibleBlocks visible;
+  const ImageF colour(kCamera.width, kCamera.height, 3, 0.25f);
+  integrate(with_colour, wall_depth(1.0), colour, kCamera, Pose::Identity(), visible);
+  integrate(without_colour, wall_depth(1.0), ImageF(), kCamera, Pose::Identity(), visible);
+  ASSERT_EQ(without_colour.block_count(), with_colour.block_count());
+  for (int b = 0; b < int(with_colour.block_count()); ++b) {
+    const int same = without_colour.hash().find(with_colour.hash().block(b));
+    ASSERT_GE(same, 0);
+    for (int v = 0; v < kVoxelsPerBlock; ++v) {
+      ASSERT_EQ(without_colour.weight(same)[v], with_colour.weight(b)[v]);
+      ASSERT_EQ(without_colour.sdf_m(same)[v], with_colour.sdf_m(b)[v]);
+    }
+  }
+  const Error error = test::error_of([&] {
+    integrate(without_colour, wall_depth(1.0), colour, kCamera, Pose::Identity(), visible);
+  });
+  EXPECT_NE(error.reason().find("keeps no colour"), std::string::npos) << error.what();
+}
+
 TEST(Integrate, ExhaustedPoolIsAClearError) {
   VolumeParams params = plane_params();
   params.block_capacity = 5;
