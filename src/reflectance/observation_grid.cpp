@@ -177,6 +177,7 @@ void ObservationGrid::refresh_surface(int v, const Eigen::Vector3f& centre, int 
   // Newton steps onto the zero level set along the (central-difference) SDF gradient: two from
   // the voxel centre, one from the previous surface point once there is one.
   const bool refine = has_surface_[v];
+  const float half = 0.5f * float(params_.voxel_size_m);
   Eigen::Vector3f p = refine ? position_[v] : centre, gradient = Eigen::Vector3f::Zero();
   bool found = false;
   for (int step = refine ? 1 : 0; step < 2; ++step) {
@@ -186,9 +187,11 @@ void ObservationGrid::refresh_surface(int v, const Eigen::Vector3f& centre, int 
     if (!(norm > 0.1f)) break;
     p -= sdf / (norm * norm) * gradient;
     found = true;
+    // A first step that lands a whole voxel outside means the surface misses this voxel: the
+    // second step only corrects for curvature, so it is skipped (most tries are such misses).
+    if (step == 0 && (p - centre).cwiseAbs().maxCoeff() > 2 * half) break;
   }
   // The surface must pass through this voxel (its neighbours own the rest of the patch).
-  const float half = 0.5f * float(params_.voxel_size_m);
   found = found && ((p - centre).cwiseAbs().maxCoeff() <= half * 1.001f);
   has_surface_[v] = found;
   // Most voxels without surface are empty space beside it in a block the surface crosses, and
