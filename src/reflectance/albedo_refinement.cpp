@@ -53,23 +53,32 @@ std::optional<Eigen::Vector3f> refine_albedo(const Observation* observations, in
                                              const Eigen::Vector3f& ks, float alpha,
                                              AlbedoAverage average) {
   std::array<const Observation*, kMaxObservationsPerVoxel> seen;  // from above the surface
+  // Their directions as arrays, for the batched lobe.
+  std::array<float, kMaxObservationsPerVoxel> x, y, z;
   int used = 0;
-  for (int k = 0; k < std::min(count, kMaxObservationsPerVoxel); ++k)
-    if (normal.dot(observations[k].direction) > 0.0f) seen[used++] = &observations[k];
+  for (int k = 0; k < std::min(count, kMaxObservationsPerVoxel); ++k) {
+    const Eigen::Vector3f& direction = observations[k].direction;
+    if (!(normal.dot(direction) > 0.0f)) continue;
+    x[used] = direction.x();
+    y[used] = direction.y();
+    z[used] = direction.z();
+    seen[used++] = &observations[k];
+  }
   if (used == 0) return std::nullopt;
 
   // Per observation sum_l exp(gamma_l) / N_l * L_l cos(theta_i,l); each light's incidence is
   // computed once per voxel.
   std::array<Eigen::Vector3f, kMaxObservationsPerVoxel> specular;
   std::fill_n(specular.begin(), used, Eigen::Vector3f::Zero());
+  std::array<float, kMaxObservationsPerVoxel> lobe;
   Eigen::Vector3f diffuse = Eigen::Vector3f::Zero();  // sum_l L_l cos(theta_i,l)
   for (const render::PointLight& light : lights) {
     const Incidence in = incidence(light, position, normal);
     if (in.irradiance.isZero()) continue;  // the light is behind the surface
     diffuse += in.irradiance;
-    for (int j = 0; j < used; ++j)
-      specular[j] += in.irradiance *
-                     render::ward_specular_lobe(normal, in.direction, seen[j]->direction, alpha);
+    render::ward_specular_lobes(normal, in.direction, {x.data(), y.data(), z.data()}, used, alpha,
+                                lobe.data());
+    for (int j = 0; j < used; ++j) specular[j] += in.irradiance * lobe[j];
   }
   if (diffuse.minCoeff() <= 1e-12f) return std::nullopt;
 

@@ -39,6 +39,21 @@ inline float ward_specular_lobe(const Eigen::Vector3f& n, const Eigen::Vector3f&
   return std::exp(gamma) / norm;
 }
 
+// Directions as three coordinate arrays (structure of arrays), for the batched lobe below.
+struct DirectionArrays {
+  const float* x;
+  const float* y;
+  const float* z;
+};
+
+// ward_specular_lobe(n, wi, wo[j], alpha) for j < count into lobe[j], as one vectorised loop
+// (AVX2 where the CPU has it): the albedo refinement evaluates it for every light and stored
+// observation of every voxel it refines. Its exp() is a polynomial good to about 2e-7 relative;
+// the values agree with ward_specular_lobe() to float rounding, which tan^2(theta_h) / alpha^2
+// and 1 / sqrt(cos_o) amplify (well below 1e-4 + 1e-6 / alpha^2 relative).
+void ward_specular_lobes(const Eigen::Vector3f& n, const Eigen::Vector3f& wi, DirectionArrays wo,
+                         int count, float alpha, float* lobe);
+
 // f(wi, wo) per RGB channel, eq. (2); 0 when either direction is below the surface.
 inline Eigen::Vector3f ward_brdf(const WardMaterial& m, const Eigen::Vector3f& n,
                                  const Eigen::Vector3f& wi, const Eigen::Vector3f& wo) {
