@@ -57,6 +57,7 @@ void ward_specular_lobes(const Eigen::Vector3f& n, const Eigen::Vector3f& wi, Di
     const float gamma = -tan_h2 * inverse_a2;  // eq. (4)
     const float value = exp_nonpositive(std::max(gamma, -40.0f)) * factor /
                         std::sqrt(std::max(cos_o, kGrazingCosine));
+    // Three selects, not one on a combined condition: GCC 12 vectorises only this form.
     const float above = cos_o > kGrazingCosine ? value : 0.0f;
     const float lit = cos_h2 > 0.0f ? above : 0.0f;
     out[j] = gamma >= -40.0f ? lit : 0.0f;
