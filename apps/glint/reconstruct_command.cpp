@@ -210,6 +210,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"voxel_m", options.params.geometry.volume.voxel_size_m},
          {"observations_per_voxel", options.params.observations.observations_per_voxel},
          {"albedo_average", reflectance::albedo_average_name(options.params.albedo_average)},
+         {"specular", options.params.specular.fit_lobe ? "hemicnn+fit" : "hemicnn"},
          {"ground_truth_poses", options.params.geometry.use_ground_truth_poses},
          {"ground_truth_segmentation", options.ground_truth_segmentation},
          {"exposure", options.params.exposure},
@@ -286,6 +287,16 @@ void register_reconstruct_command(CLI::App& app) {
           "per-channel median (robust to mispredicted highlights)")
       ->check(CLI::IsMember({"mean", "median"}))
       ->default_str(reflectance::albedo_average_name(params.albedo_average));
+  command
+      ->add_option_function<std::string>(
+          "--specular",
+          [options](const std::string& name) {
+            options->params.specular.fit_lobe = name == "hemicnn+fit";
+          },
+          "Each frame's ks and alpha per segment: the HemiCNN's (the paper), or a photometric "
+          "fit of the Ward lobe to the same voxels' observations where the lobe explains them")
+      ->check(CLI::IsMember({"hemicnn", "hemicnn+fit"}))
+      ->default_str(params.specular.fit_lobe ? "hemicnn+fit" : "hemicnn");
   command->add_option("--seed", params.specular.seed, "Seed of the voxel sampling")
       ->capture_default_str();
   command->add_option("--report", options->report,

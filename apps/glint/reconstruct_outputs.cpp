@@ -93,6 +93,7 @@ nlohmann::json materials_json(const reflectance::ReflectancePipeline& pipeline) 
     entry["id"] = id;
     entry["latest"] = ward_json(material.latest);
     entry["estimates"] = material.estimates;
+    entry["lobe_fitted"] = material.fitted;
     entry["last_frame"] = material.last_frame;
     entry["voxels"] = voxels[id];
     if (refined.count(id) && refined[id].second > 0)

@@ -5,26 +5,10 @@
 #include <numeric>
 
 #include "core/error.h"
+#include "reflectance/light_incidence.h"
 
 namespace glint::reflectance {
 namespace {
-
-// Unit direction to the light and L_l cos(theta_i) (zero when the light is behind the surface).
-struct Incidence {
-  Eigen::Vector3f direction;
-  Eigen::Vector3f irradiance;
-};
-
-Incidence incidence(const render::PointLight& light, const Eigen::Vector3f& position,
-                    const Eigen::Vector3f& normal) {
-  const Eigen::Vector3f to_light = light.position.cast<float>() - position;
-  const float distance2 = to_light.squaredNorm();
-  if (distance2 <= 0.0f) return {Eigen::Vector3f::UnitZ(), Eigen::Vector3f::Zero()};
-  const Eigen::Vector3f wi = to_light / std::sqrt(distance2);
-  const float cos_i = normal.dot(wi);
-  if (cos_i <= 0.0f) return {wi, Eigen::Vector3f::Zero()};
-  return {wi, light.intensity * (cos_i / distance2)};
-}
 
 // Median of values[0, n), n >= 1; reorders them.
 float median(float* values, int n) {

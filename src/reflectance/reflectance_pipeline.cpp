@@ -8,6 +8,16 @@
 #include "reflectance/albedo_refinement.h"
 
 namespace glint::reflectance {
+namespace {
+
+// The lobe fit leaves out observations clipped by the sensor: an 8-bit (or normalised) pixel
+// saturates at 1, which is radiance 1 / exposure; 0.99 allows for rounding.
+SpecularParams with_saturation(SpecularParams params, float exposure) {
+  params.fit.saturated_radiance = 0.99f / exposure;
+  return params;
+}
+
+}  // namespace
 
 ReflectancePipeline::ReflectancePipeline(const Intrinsics& intrinsics,
                                          const ReflectanceParams& params, const HemiCnn& network,
@@ -17,7 +27,7 @@ ReflectancePipeline::ReflectancePipeline(const Intrinsics& intrinsics,
       geometry_(intrinsics, params.geometry),
       grid_(params.observations),
       segment_map_(params.segments),
-      specular_(network, params.specular),
+      specular_(network, with_saturation(params.specular, params.exposure)),
       lights_(std::move(lights)) {
   if (params.albedo_refresh_frames < 1)
     throw Error("reflectance pipeline", "albedo_refresh_frames", "must be >= 1");
@@ -100,7 +110,7 @@ ReflectanceFrame ReflectancePipeline::process(const io::RgbdFrame& frame,
   timings_.add("segmentation", stage.elapsed_ms());
 
   stage.restart();
-  specular_.update(grid_, segment_map_, segment_map_.frame_segments(), frame_);
+  specular_.update(grid_, segment_map_, segment_map_.frame_segments(), lights_, frame_);
   timings_.add("specular", stage.elapsed_ms());
 
   stage.restart();

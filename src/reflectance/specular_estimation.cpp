@@ -37,10 +37,12 @@ const SegmentMaterial* SpecularEstimator::material(int segment) const {
 }
 
 void SpecularEstimator::update(const ObservationGrid& grid, const SegmentMap& segment_map,
-                               const std::vector<int>& segments, int frame) {
+                               const std::vector<int>& segments,
+                               const std::vector<render::PointLight>& lights, int frame) {
   const int count = params_.voxels_per_estimate;
   const int image_floats = 3 * hemi_.size * hemi_.size;
   std::vector<std::optional<render::WardMaterial>> estimates(segments.size());
+  std::vector<std::optional<SpecularFit>> fits(segments.size());
   tbb::parallel_for(std::size_t(0), segments.size(), [&](std::size_t i) {
     // Seeded per (seed, frame, segment): the same run gives the same samples on any thread.
     std::mt19937_64 random(params_.seed * 0x9E3779B97F4A7C15ull + std::uint64_t(frame) * 7919u +
@@ -59,6 +61,12 @@ void SpecularEstimator::update(const ObservationGrid& grid, const SegmentMap& se
       make_hemi_image(grid.observations(voxels[k]), grid.observation_count(voxels[k]),
                       grid.normal(voxels[k]), hemi_, images.data() + std::size_t(k) * image_floats);
     estimates[i] = render::from_perceptual(network_.predict(images.data(), count));
+    if (!params_.fit_lobe) return;
+    std::vector<FitVoxel> fit_voxels(count);
+    for (int k = 0; k < count; ++k)
+      fit_voxels[k] = {grid.observations(voxels[k]), grid.observation_count(voxels[k]),
+                       grid.position(voxels[k]), grid.normal(voxels[k])};
+    fits[i] = fit_specular(fit_voxels, lights, params_.fit);
   });
   for (std::size_t i = 0; i < segments.size(); ++i) {
     if (!estimates[i]) continue;
@@ -67,6 +75,20 @@ void SpecularEstimator::update(const ObservationGrid& grid, const SegmentMap& se
     SegmentMaterial& material = materials_[segments[i]];
     material.ward = to_material(fused->second.mean());
     material.latest = *estimates[i];
+    if (fits[i]) {
+      auto& lobe = fused_lobe_.try_emplace(segments[i], params_.fusion_divisor).first->second;
+      lobe.add(Eigen::Vector4f(fits[i]->ks.x(), fits[i]->ks.y(), fits[i]->ks.z(), fits[i]->alpha));
+      material.latest.ks = fits[i]->ks;
+      material.latest.alpha = fits[i]->alpha;
+      ++material.fitted;
+    }
+    // Once fitted often enough, a segment's ks and alpha are the fused fits alone: the
+    // network's estimates of the frames without a fit would pull them towards its own bias.
+    if (const auto lobe = fused_lobe_.find(segments[i]);
+        lobe != fused_lobe_.end() && material.fitted >= params_.min_fits) {
+      material.ward.ks = lobe->second.mean().head<3>();
+      material.ward.alpha = lobe->second.mean()[3];
+    }
     ++material.estimates;
     material.last_frame = frame;
   }

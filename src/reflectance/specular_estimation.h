@@ -3,6 +3,10 @@
 // voxels_per_estimate (25) of its voxels from its ring buffer, turns their observations into
 // HemiImages, and the HemiCNN predicts one material from the set. The per-frame estimates are
 // fused over time by a running mean whose divisor is clamped (60), per Ward parameter.
+// With fit_lobe (glint's addition, reflectance/specular_fit.h) a photometric fit of the Ward
+// lobe to the same voxels' observations also runs; where it explains them, its ks and alpha
+// are fused separately and replace the network's once the segment has min_fits of them. kd is
+// always the network's.
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -13,6 +17,7 @@
 #include "reflectance/material_fusion.h"
 #include "reflectance/observation_grid.h"
 #include "reflectance/segment_map.h"
+#include "reflectance/specular_fit.h"
 #include "render/ward.h"
 
 namespace glint::reflectance {
@@ -21,6 +26,9 @@ struct SpecularParams {
   int voxels_per_estimate = 25;
   int min_observations = 5;  // a sampled voxel needs this many observations
   int fusion_divisor = 60;   // clamp of the running mean's divisor
+  bool fit_lobe = true;      // false: the paper's HemiCNN-only estimate
+  int min_fits = 10;         // frames with a lobe fit before the fits replace the network
+  SpecularFitParams fit;
   std::uint64_t seed = 1;
 };
 
@@ -29,6 +37,7 @@ struct SegmentMaterial {
   render::WardMaterial ward;    // the fused (kd, ks, alpha)
   render::WardMaterial latest;  // the latest frame's estimate
   int estimates = 0;            // frames that produced an estimate
+  int fitted = 0;               // of those, frames whose ks, alpha came from the lobe fit
   int last_frame = -1;
 };
 
@@ -37,9 +46,11 @@ class SpecularEstimator {
   // The network's projection (parabolic or orthographic) is used for the HemiImages.
   SpecularEstimator(const HemiCnn& network, const SpecularParams& params = {});
 
-  // Estimates every segment in `segments` that has enough sampled voxels, and fuses.
+  // Estimates every segment in `segments` that has enough sampled voxels, and fuses. `lights`
+  // are those of the scene, for the lobe fit.
   void update(const ObservationGrid& grid, const SegmentMap& segment_map,
-              const std::vector<int>& segments, int frame);
+              const std::vector<int>& segments, const std::vector<render::PointLight>& lights,
+              int frame);
 
   // The fused material of a segment, or nullptr before its first estimate.
   const SegmentMaterial* material(int segment) const;
@@ -50,7 +61,8 @@ class SpecularEstimator {
   SpecularParams params_;
   HemiImageParams hemi_;
   std::map<int, SegmentMaterial> materials_;
-  std::map<int, ClampedRunningMean<7>> fused_;
+  std::map<int, ClampedRunningMean<7>> fused_;       // the network's (kd, ks, alpha)
+  std::map<int, ClampedRunningMean<4>> fused_lobe_;  // the fits' (ks, alpha)
 };
 
 }  // namespace glint::reflectance

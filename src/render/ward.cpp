@@ -64,4 +64,19 @@ void ward_specular_lobes(const Eigen::Vector3f& n, const Eigen::Vector3f& wi, Di
   }
 }
 
+#if defined(__x86_64__)
+__attribute__((target_clones("arch=x86-64-v3", "default")))
+#endif
+void ward_roughness_factors(const float* tan2_h, int count, float alpha, float* factor) {
+  const float a = std::max(alpha, kMinWardAlpha);
+  const float inverse_a2 = 1.0f / (a * a);
+  const float* __restrict in = tan2_h;
+  float* __restrict out = factor;
+  for (int j = 0; j < count; ++j) {
+    const float gamma = -in[j] * inverse_a2;  // eq. (4)
+    const float value = exp_nonpositive(std::max(gamma, -40.0f)) * inverse_a2;
+    out[j] = gamma >= -40.0f ? value : 0.0f;
+  }
+}
+
 }  // namespace glint::render

@@ -54,6 +54,11 @@ struct DirectionArrays {
 void ward_specular_lobes(const Eigen::Vector3f& n, const Eigen::Vector3f& wi, DirectionArrays wo,
                          int count, float alpha, float* lobe);
 
+// exp(-tan2_h[j] / alpha^2) / alpha^2 for j < count into factor[j] (0 below exp(-40)): the part
+// of the lobe (eqs 3-4) that depends on alpha, for fits that try many alphas on the same
+// directions. Vectorised as ward_specular_lobes().
+void ward_roughness_factors(const float* tan2_h, int count, float alpha, float* factor);
+
 // f(wi, wo) per RGB channel, eq. (2); 0 when either direction is below the surface.
 inline Eigen::Vector3f ward_brdf(const WardMaterial& m, const Eigen::Vector3f& n,
                                  const Eigen::Vector3f& wi, const Eigen::Vector3f& wo) {

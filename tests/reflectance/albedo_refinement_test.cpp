@@ -5,23 +5,12 @@
 #include <vector>
 
 #include "core/error.h"
+#include "reflectance/ward_observations.h"
 
 namespace glint::reflectance {
 namespace {
 
-// The colour a camera in direction wo sees at `position` under `lights`: eq. (6).
-Eigen::Vector3f observed(const render::WardMaterial& m, const Eigen::Vector3f& position,
-                         const Eigen::Vector3f& normal, const Eigen::Vector3f& wo,
-                         const std::vector<render::PointLight>& lights) {
-  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-  for (const auto& light : lights) {
-    const Eigen::Vector3f to_light = light.position.cast<float>() - position;
-    const Eigen::Vector3f wi = to_light.normalized();
-    sum += render::ward_brdf(m, normal, wi, wo).cwiseProduct(light.intensity) *
-           std::max(0.0f, normal.dot(wi)) / to_light.squaredNorm();
-  }
-  return sum;
-}
+using test_support::observed;
 
 TEST(AlbedoRefinement, RecoversTheDiffuseAlbedoOfARenderedVoxel) {
   render::WardMaterial m;

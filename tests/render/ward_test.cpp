@@ -106,5 +106,19 @@ TEST(Ward, BatchedLobeMatchesTheScalarOne) {
   }
 }
 
+TEST(Ward, RoughnessFactorsAreTheLobesAlphaDependentPart) {
+  // exp(-tan2 / alpha^2) / alpha^2 against the library exp, up to exp(-40) and zero beyond.
+  const std::vector<float> tan2 = {0.0f, 1e-4f, 0.003f, 0.02f, 0.1f, 0.5f, 2.0f, 3.9f, 4.1f, 50.0f};
+  std::vector<float> factor(tan2.size());
+  for (const float alpha : {0.02f, 0.1f, 0.3f}) {
+    ward_roughness_factors(tan2.data(), int(tan2.size()), alpha, factor.data());
+    for (std::size_t j = 0; j < tan2.size(); ++j) {
+      const float gamma = -tan2[j] / (alpha * alpha);
+      const float expected = gamma < -40.0f ? 0.0f : std::exp(gamma) / (alpha * alpha);
+      ASSERT_NEAR(factor[j], expected, 1e-5f * expected) << "alpha " << alpha << " j " << j;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace glint::render

@@ -1,0 +1,168 @@
+#include "reflectance/specular_fit.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "reflectance/light_incidence.h"
+#include "render/ward.h"
+
+namespace glint::reflectance {
+namespace {
+
+// The fit's data in structure-of-arrays form. A term is one (observation, light) pair whose
+// lobe can be non-zero: its tan^2(theta_h) and L_l cos(theta_i) / (4 pi sqrt(cos_i cos_o)) per
+// channel, so that the lobe sum of eq. (6) at roughness alpha is
+//   G_k = sum over k's terms of weight * exp(-tan2 / alpha^2) / alpha^2      (eqs 3-4)
+class LobeProblem {
+ public:
+  LobeProblem(const std::vector<FitVoxel>& voxels, const std::vector<render::PointLight>& lights,
+              const SpecularFitParams& params);
+
+  int observations() const { return int(centred_colour_.size()); }
+  double variation() const { return variation_.sum(); }
+
+  // The squared residual of the best ks at `alpha` (summed over channels); the slope into *ks.
+  double residual(float alpha, Eigen::Vector3f* ks) const;
+
+ private:
+  void add_voxel(const FitVoxel& voxel, const std::vector<render::PointLight>& lights,
+                 const SpecularFitParams& params);
+
+  std::vector<float> tan2_;
+  std::vector<Eigen::Vector3f> weight_;
+  std::vector<int> term_observation_;
+  std::vector<Eigen::Vector3f> centred_colour_;  // B_vk minus the voxel's mean
+  std::vector<int> voxel_end_;                   // observations [previous end, end) per voxel
+  Eigen::Vector3d variation_ = Eigen::Vector3d::Zero();  // sum of centred_colour^2
+  mutable std::vector<float> factor_;                    // per term, at the alpha being evaluated
+  mutable std::vector<Eigen::Vector3f> lobe_sum_;
+};
+
+LobeProblem::LobeProblem(const std::vector<FitVoxel>& voxels,
+                         const std::vector<render::PointLight>& lights,
+                         const SpecularFitParams& params) {
+  for (const FitVoxel& voxel : voxels) add_voxel(voxel, lights, params);
+  for (const Eigen::Vector3f& c : centred_colour_) variation_ += c.cast<double>().cwiseAbs2();
+  lobe_sum_.resize(centred_colour_.size());
+  factor_.resize(tan2_.size());
+}
+
+void LobeProblem::add_voxel(const FitVoxel& voxel, const std::vector<render::PointLight>& lights,
+                            const SpecularFitParams& params) {
+  // Beyond it the lobe is below exp(-40) of its peak at every alpha searched.
+  const float negligible_tan2 = 40.0f * params.alpha_max * params.alpha_max;
+  const int first = observations();
+  const std::size_t first_term = tan2_.size();
+  Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+  for (int k = 0; k < std::min(voxel.count, kMaxObservationsPerVoxel); ++k) {
+    const Observation& o = voxel.observations[k];
+    const float cos_o = voxel.normal.dot(o.direction);
+    if (!(cos_o > 0.0f) || !(o.colour.maxCoeff() < params.saturated_radiance)) continue;
+    const int index = observations();
+    for (const render::PointLight& light : lights) {
+      const Incidence in = incidence(light, voxel.position, voxel.normal);
+      if (in.cosine <= render::kGrazingCosine || cos_o <= render::kGrazingCosine) continue;
+      const Eigen::Vector3f h = in.direction + o.direction;
+      const float n_h = voxel.normal.dot(h);
+      if (n_h <= 0.0f) continue;
+      const float cos_h2 = std::min(1.0f, n_h * n_h / h.squaredNorm());
+      const float tan2 = (1.0f - cos_h2) / cos_h2;
+      if (tan2 > negligible_tan2) continue;  // no lobe in the searched range reaches it
+      tan2_.push_back(tan2);
+      weight_.push_back(in.irradiance / (4.0f * float(M_PI) * std::sqrt(in.cosine * cos_o)));
+      term_observation_.push_back(index);
+    }
+    centred_colour_.push_back(o.colour);
+    mean += o.colour;
+  }
+  const int added = observations() - first;
+  if (added < 2) {  // one observation has no variation to explain
+    centred_colour_.resize(first);
+    tan2_.resize(first_term);
+    weight_.resize(first_term);
+    term_observation_.resize(first_term);
+    return;
+  }
+  mean /= float(added);
+  for (int k = first; k < observations(); ++k) centred_colour_[k] -= mean;
+  voxel_end_.push_back(observations());
+}
+
+double LobeProblem::residual(float alpha, Eigen::Vector3f* ks) const {
+  render::ward_roughness_factors(tan2_.data(), int(tan2_.size()), alpha, factor_.data());
+  std::fill(lobe_sum_.begin(), lobe_sum_.end(), Eigen::Vector3f::Zero());
+  for (std::size_t t = 0; t < tan2_.size(); ++t)
+    lobe_sum_[term_observation_[t]] += weight_[t] * factor_[t];
+  // Per channel: the slope of the centred colours over the centred lobe sums.
+  Eigen::Vector3d covariance = Eigen::Vector3d::Zero(), lobe_variation = Eigen::Vector3d::Zero();
+  int begin = 0;
+  for (const int end : voxel_end_) {
+    Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+    for (int k = begin; k < end; ++k) mean += lobe_sum_[k];
+    mean /= float(end - begin);
+    for (int k = begin; k < end; ++k) {
+      const Eigen::Vector3d g = (lobe_sum_[k] - mean).cast<double>();
+      covariance += g.cwiseProduct(centred_colour_[k].cast<double>());
+      lobe_variation += g.cwiseAbs2();
+    }
+    begin = end;
+  }
+  double squared = 0;
+  for (int c = 0; c < 3; ++c) {
+    // ks >= 0: a lobe that anti-correlates with the observations fits as no lobe.
+    const bool lobe = covariance[c] > 0 && lobe_variation[c] > 0;
+    const double slope = lobe ? covariance[c] / lobe_variation[c] : 0.0;
+    (*ks)[c] = float(slope);
+    squared += variation_[c] - slope * covariance[c];
+  }
+  return squared;
+}
+
+}  // namespace
+
+std::optional<SpecularFit> fit_specular(const std::vector<FitVoxel>& voxels,
+                                        const std::vector<render::PointLight>& lights,
+                                        const SpecularFitParams& params) {
+  const LobeProblem problem(voxels, lights, params);
+  if (!(problem.variation() > 0)) return std::nullopt;
+  const double lo = std::log(params.alpha_min), hi = std::log(params.alpha_max);
+  const int steps = std::max(params.scan_steps, 2);
+  auto log_alpha = [&](int i) { return lo + (hi - lo) * i / (steps - 1); };
+  Eigen::Vector3f ks;
+  auto residual = [&](double u) { return problem.residual(float(std::exp(u)), &ks); };
+
+  int best = 0;
+  double best_residual = residual(log_alpha(0));
+  for (int i = 1; i < steps; ++i) {
+    const double r = residual(log_alpha(i));
+    if (r < best_residual) best_residual = r, best = i;
+  }
+  // Golden-section search between the scan's neighbours of its best alpha.
+  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
+  double a = log_alpha(std::max(best - 1, 0)), b = log_alpha(std::min(best + 1, steps - 1));
+  double x1 = b - ratio * (b - a), x2 = a + ratio * (b - a);
+  double r1 = residual(x1), r2 = residual(x2);
+  for (int i = 0; i < params.refine_steps; ++i) {
+    if (r1 < r2) {
+      b = x2, x2 = x1, r2 = r1;
+      x1 = b - ratio * (b - a), r1 = residual(x1);
+    } else {
+      a = x1, x1 = x2, r1 = r2;
+      x2 = a + ratio * (b - a), r2 = residual(x2);
+    }
+  }
+  double u = r1 < r2 ? x1 : x2, r = std::min(r1, r2);
+  if (best_residual < r) u = log_alpha(best), r = best_residual;
+
+  SpecularFit fit;
+  fit.alpha = float(std::exp(u));
+  problem.residual(fit.alpha, &fit.ks);
+  fit.explained = float(std::clamp(1.0 - r / problem.variation(), 0.0, 1.0));
+  fit.observations = problem.observations();
+  // ks > 1 reflects more than arrives: the lobe is fitting something else (typically a few
+  // unsaturated samples on the flank of a clipped, misaligned highlight).
+  if (fit.explained < params.min_explained || fit.ks.maxCoeff() > 1.0f) return std::nullopt;
+  return fit;
+}
+
+}  // namespace glint::reflectance
