@@ -5,8 +5,9 @@
 # runs glint reconstruct with ground-truth poses:
 #   - with ground-truth and with glint's own segmentation, at 2 cm observation voxels;
 #   - with the paper's mean of the per-observation albedos instead of glint's median;
+#   - with the HemiCNN's ks, alpha alone (the paper), without glint's lobe fit;
 #   - with the modified (parabolic, lambda_d 0.1, lambda_l 0.3) and the unmodified
-#     (orthographic, lambda 1) HemiCNN, ground-truth segmentation;
+#     (orthographic, lambda 1) HemiCNN, ground-truth segmentation, both without the lobe fit;
 #   - at 1 cm observation voxels (Table 3 timings);
 #   - "fast": 1 cm geometry voxels instead of 5 mm (a CPU budget option, not the paper's).
 # Every 10th frame (and the last) is scored; about 25 minutes on 2 cores for the three scenes.
@@ -40,7 +41,10 @@ for scene in $SCENES; do
   run ownseg --model "$MODELS/hemicnn.json" --eval-every 10
   run mean-albedo --gt-segmentation --model "$MODELS/hemicnn.json" --eval-every 10 \
     --albedo-average mean
-  run unmodified --gt-segmentation --model "$MODELS/hemicnn-unmodified.json" --eval-every 10
+  run hemicnn --gt-segmentation --model "$MODELS/hemicnn.json" --eval-every 10 \
+    --specular hemicnn
+  run unmodified --gt-segmentation --model "$MODELS/hemicnn-unmodified.json" --eval-every 10 \
+    --specular hemicnn
   run gtseg-1cm --gt-segmentation --model "$MODELS/hemicnn.json" --obs-voxel 0.01 --eval-every 0
   run fast --gt-segmentation --model "$MODELS/hemicnn.json" --voxel 0.01 --eval-every 0
 done

@@ -62,13 +62,14 @@ def main():
               "| paper (bunnies, own pipeline) | " +
               " | ".join(str(PAPER_AVERAGE[q][0]) for q in QUANTITIES) + " | 27.61 | |"]
     for scene in scenes:
-        for variant in ["gtseg", "ownseg", "mean-albedo", "unmodified", "gtseg-1cm", "fast"]:
+        for variant in ["gtseg", "ownseg", "mean-albedo", "hemicnn", "unmodified", "gtseg-1cm",
+                        "fast"]:
             r = load(out, scene, variant)
             if scored(r):
                 lines.append(averages_row(r, f"{scene} / {variant}"))
     lines.append("")
     for scene in scenes:
-        for variant in ["gtseg", "ownseg", "mean-albedo", "unmodified"]:
+        for variant in ["gtseg", "ownseg", "mean-albedo", "hemicnn", "unmodified"]:
             r = load(out, scene, variant)
             if scored(r):
                 lines += table1(r, f"{scene}, {variant}")
