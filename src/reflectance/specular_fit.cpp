@@ -34,6 +34,7 @@ class LobeProblem {
   std::vector<Eigen::Vector3f> centred_colour_;  // B_vk minus the voxel's mean
   std::vector<int> voxel_end_;                   // observations [previous end, end) per voxel
   Eigen::Vector3d variation_ = Eigen::Vector3d::Zero();  // sum of centred_colour^2
+  std::vector<Incidence> lit_;                           // scratch of add_voxel()
   mutable std::vector<float> factor_;                    // per term, at the alpha being evaluated
   mutable std::vector<Eigen::Vector3f> lobe_sum_;
 };
@@ -51,6 +52,11 @@ void LobeProblem::add_voxel(const FitVoxel& voxel, const std::vector<render::Poi
                             const SpecularFitParams& params) {
   // Beyond it the lobe is below exp(-40) of its peak at every alpha searched.
   const float negligible_tan2 = 40.0f * params.alpha_max * params.alpha_max;
+  lit_.clear();  // the lights above the voxel's surface, once per voxel
+  for (const render::PointLight& light : lights)
+    if (const Incidence in = incidence(light, voxel.position, voxel.normal);
+        in.cosine > render::kGrazingCosine)
+      lit_.push_back(in);
   const int first = observations();
   const std::size_t first_term = tan2_.size();
   Eigen::Vector3f mean = Eigen::Vector3f::Zero();
@@ -59,19 +65,14 @@ void LobeProblem::add_voxel(const FitVoxel& voxel, const std::vector<render::Poi
     const float cos_o = voxel.normal.dot(o.direction);
     if (!(cos_o > 0.0f) || !(o.colour.maxCoeff() < params.saturated_radiance)) continue;
     const int index = observations();
-    for (const render::PointLight& light : lights) {
-      const Incidence in = incidence(light, voxel.position, voxel.normal);
-      if (in.cosine <= render::kGrazingCosine || cos_o <= render::kGrazingCosine) continue;
-      const Eigen::Vector3f h = in.direction + o.direction;
-      const float n_h = voxel.normal.dot(h);
-      if (n_h <= 0.0f) continue;
-      const float cos_h2 = std::min(1.0f, n_h * n_h / h.squaredNorm());
-      const float tan2 = (1.0f - cos_h2) / cos_h2;
-      if (tan2 > negligible_tan2) continue;  // no lobe in the searched range reaches it
-      tan2_.push_back(tan2);
-      weight_.push_back(in.irradiance / (4.0f * float(M_PI) * std::sqrt(in.cosine * cos_o)));
-      term_observation_.push_back(index);
-    }
+    if (cos_o > render::kGrazingCosine)  // a grazing view has no lobe term (render/ward.h)
+      for (const Incidence& in : lit_) {
+        const float tan2 = render::ward_half_angle_tan2(voxel.normal, in.direction, o.direction);
+        if (tan2 > negligible_tan2) continue;  // no lobe in the searched range reaches it
+        tan2_.push_back(tan2);
+        weight_.push_back(in.irradiance / (4.0f * float(M_PI) * std::sqrt(in.cosine * cos_o)));
+        term_observation_.push_back(index);
+      }
     centred_colour_.push_back(o.colour);
     mean += o.colour;
   }

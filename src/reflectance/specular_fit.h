@@ -1,8 +1,8 @@
 #pragma once
 // Photometric fit of a segment's specular lobe (glint's addition to paper 1 §3.6): with the
 // lights, the voxel normals and eq. (6)'s image formation,
-//   B_vk = kd_v / pi * sum_l L_l cos(theta_i,l) + ks * sum_l exp(gamma_l) / N_l * L_l
-//   cos(theta_i,l)
+//   B_vk = kd_v / pi * sum_l L_l cos(theta_i,l)
+//          + ks * sum_l exp(gamma_l) / N_l * L_l cos(theta_i,l)
 // the diffuse term is the same for every observation k of voxel v, so subtracting each voxel's
 // mean observation removes the unknown, spatially varying kd_v. What is left is linear in ks:
 // for a given alpha, ks per channel is a least-squares slope in closed form, and alpha is the

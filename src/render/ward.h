@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace glint::render {
 
@@ -21,6 +22,16 @@ inline constexpr float kMinWardAlpha = 1e-3f;
 // Cosines below this count as grazing: the specular term's 1/sqrt(cos_i cos_o) diverges there.
 inline constexpr float kGrazingCosine = 1e-4f;
 
+// tan^2(theta_h), theta_h the angle between unit normal n and the half vector of unit wi, wo;
+// +infinity when the half vector is perpendicular to n.
+inline float ward_half_angle_tan2(const Eigen::Vector3f& n, const Eigen::Vector3f& wi,
+                                  const Eigen::Vector3f& wo) {
+  const Eigen::Vector3f h = wi + wo;  // unnormalised half vector
+  const float cos_h2 = std::min(1.0f, n.dot(h) * n.dot(h) / h.squaredNorm());
+  if (cos_h2 <= 0.0f) return std::numeric_limits<float>::infinity();
+  return (1.0f - cos_h2) / cos_h2;
+}
+
 // The specular lobe's scalar factor exp(gamma) / N (eqs 3-4) for unit normal n and unit wi, wo
 // on the normal's side; 0 at grazing angles or when either direction is below the surface.
 inline float ward_specular_lobe(const Eigen::Vector3f& n, const Eigen::Vector3f& wi,
@@ -28,11 +39,7 @@ inline float ward_specular_lobe(const Eigen::Vector3f& n, const Eigen::Vector3f&
   const float cos_i = n.dot(wi), cos_o = n.dot(wo);
   if (cos_i <= kGrazingCosine || cos_o <= kGrazingCosine) return 0.0f;
   const float a = std::max(alpha, kMinWardAlpha);
-  const Eigen::Vector3f h = wi + wo;  // unnormalised half vector
-  const float cos_h2 = std::min(1.0f, n.dot(h) * n.dot(h) / h.squaredNorm());
-  if (cos_h2 <= 0.0f) return 0.0f;
-  const float tan_h2 = (1.0f - cos_h2) / cos_h2;  // tan^2(theta_h)
-  const float gamma = -tan_h2 / (a * a);          // eq. (4)
+  const float gamma = -ward_half_angle_tan2(n, wi, wo) / (a * a);  // eq. (4)
   // exp(-40) / N < 1e-8 even at alpha = kMinWardAlpha and grazing cosines: skip exp and sqrt.
   if (gamma < -40.0f) return 0.0f;
   const float norm = 4.0f * float(M_PI) * a * a * std::sqrt(cos_i * cos_o);  // eq. (3)
