@@ -4,15 +4,20 @@
 
 namespace glint::fusion {
 
+namespace {
+PoolArray<float> voxel_pool(const VolumeParams& params) {
+  return make_pool<float>(params.block_capacity * kVoxelsPerBlock, "TSDF volume");
+}
+}  // namespace
+
 TsdfVolume::TsdfVolume(const VolumeParams& params)
     : params_((validate(params), params)),
       hash_(params.block_capacity),
-      // new T[] without () leaves the pools uninitialised: pages are committed on first use.
-      sdf_m_(new float[params.block_capacity * kVoxelsPerBlock]),
-      weight_(new float[params.block_capacity * kVoxelsPerBlock]),
-      red_(params.colour ? new float[params.block_capacity * kVoxelsPerBlock] : nullptr),
-      green_(params.colour ? new float[params.block_capacity * kVoxelsPerBlock] : nullptr),
-      blue_(params.colour ? new float[params.block_capacity * kVoxelsPerBlock] : nullptr),
+      sdf_m_(voxel_pool(params)),
+      weight_(voxel_pool(params)),
+      red_(params.colour ? voxel_pool(params) : PoolArray<float>()),
+      green_(params.colour ? voxel_pool(params) : PoolArray<float>()),
+      blue_(params.colour ? voxel_pool(params) : PoolArray<float>()),
       last_visible_(new std::atomic<int>[params.block_capacity]) {
   for (std::size_t b = 0; b < params.block_capacity; ++b) last_visible_[b].store(-1);
 }

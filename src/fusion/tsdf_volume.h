@@ -12,6 +12,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/pool_memory.h"
 #include "fusion/host_device.h"
 #include "fusion/volume_params.h"
 #include "fusion/voxel_block_hash.h"
@@ -69,7 +70,7 @@ class TsdfVolume {
 
   VolumeParams params_;
   VoxelBlockHash hash_;
-  std::unique_ptr<float[]> sdf_m_, weight_, red_, green_, blue_;
+  PoolArray<float> sdf_m_, weight_, red_, green_, blue_;
   std::unique_ptr<std::atomic<int>[]> last_visible_;
 };
 

@@ -15,6 +15,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/pool_memory.h"
 #include "fusion/host_device.h"
 
 namespace glint::fusion {
@@ -60,8 +61,12 @@ class VoxelBlockHash {
 
   std::size_t capacity_;
   std::size_t slots_;
-  std::unique_ptr<std::atomic<std::uint64_t>[]> keys_;
-  std::unique_ptr<std::atomic<int>[]> values_;
+  // Key and pool index side by side: a probe touches one cache line.
+  struct Slot {
+    std::atomic<std::uint64_t> key;
+    std::atomic<int> value;
+  };
+  PoolArray<Slot> slots_table_;
   std::vector<Eigen::Vector3i> blocks_;
   std::atomic<std::size_t> used_{0};
 };

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdlib>
 #include <string>
 
 #include "core/error.h"
@@ -14,14 +13,6 @@
 
 namespace glint::reflectance {
 namespace {
-
-template <class T>
-std::unique_ptr<T[], void (*)(void*)> zeroed_pool(std::size_t count) {
-  // calloc: large zeroed allocations are mapped lazily, so untouched voxels cost no memory.
-  void* memory = std::calloc(count, sizeof(T));
-  if (!memory) throw Error("observation grid", "", "cannot reserve the voxel pools");
-  return {static_cast<T*>(memory), std::free};
-}
 
 // Asks for the cache lines of [p, p + bytes) ahead of use.
 void prefetch_lines(const void* p, std::size_t bytes) {
@@ -77,19 +68,7 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
     : params_(params),
       side_(block_side(params)),
       voxels_per_block_(side_ * side_ * side_),
-      hash_(std::max<std::size_t>(1, voxel_capacity(params) / std::size_t(side_ * side_ * side_))),
-      observations_(zeroed_pool<Observation>(1)),
-      nearest_(zeroed_pool<NearestObservation>(1)),
-      observation_count_(zeroed_pool<std::uint8_t>(1)),
-      position_(zeroed_pool<Eigen::Vector3f>(1)),
-      normal_(zeroed_pool<Eigen::Vector3f>(1)),
-      refined_kd_(zeroed_pool<Eigen::Vector3f>(1)),
-      next_refresh_frame_(zeroed_pool<int>(1)),
-      surface_misses_(zeroed_pool<std::uint8_t>(1)),
-      has_surface_(zeroed_pool<bool>(1)),
-      segment_(zeroed_pool<std::int32_t>(1)),
-      segment_confidence_(zeroed_pool<std::int16_t>(1)),
-      has_refined_kd_(zeroed_pool<bool>(1)) {
+      hash_(std::max<std::size_t>(1, voxel_capacity(params) / std::size_t(side_ * side_ * side_))) {
   if (params.observations_per_voxel < 1 || params.observations_per_voxel > kMaxObservationsPerVoxel)
     throw Error("observation grid", "observations_per_voxel",
                 "must be in 1.." + std::to_string(kMaxObservationsPerVoxel));
@@ -100,18 +79,20 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
   if (params.surface_retry_doublings < 0 || params.surface_retry_doublings > 8)
     throw Error("observation grid", "surface_retry_doublings", "must be in 0..8");
   const std::size_t voxels = hash_.capacity() * voxels_per_block_;
-  observations_ = zeroed_pool<Observation>(voxels * params.observations_per_voxel);
-  nearest_ = zeroed_pool<NearestObservation>(voxels * params.observations_per_voxel);
-  observation_count_ = zeroed_pool<std::uint8_t>(voxels);
-  position_ = zeroed_pool<Eigen::Vector3f>(voxels);
-  normal_ = zeroed_pool<Eigen::Vector3f>(voxels);
-  refined_kd_ = zeroed_pool<Eigen::Vector3f>(voxels);
-  next_refresh_frame_ = zeroed_pool<int>(voxels);
-  surface_misses_ = zeroed_pool<std::uint8_t>(voxels);
-  has_surface_ = zeroed_pool<bool>(voxels);
-  segment_ = zeroed_pool<std::int32_t>(voxels);
-  segment_confidence_ = zeroed_pool<std::int16_t>(voxels);
-  has_refined_kd_ = zeroed_pool<bool>(voxels);
+  observations_ =
+      make_pool<Observation>(voxels * params.observations_per_voxel, "observation grid");
+  nearest_ =
+      make_pool<NearestObservation>(voxels * params.observations_per_voxel, "observation grid");
+  observation_count_ = make_pool<std::uint8_t>(voxels, "observation grid");
+  position_ = make_pool<Eigen::Vector3f>(voxels, "observation grid");
+  normal_ = make_pool<Eigen::Vector3f>(voxels, "observation grid");
+  refined_kd_ = make_pool<Eigen::Vector3f>(voxels, "observation grid");
+  next_refresh_frame_ = make_pool<int>(voxels, "observation grid");
+  surface_misses_ = make_pool<std::uint8_t>(voxels, "observation grid");
+  has_surface_ = make_pool<bool>(voxels, "observation grid");
+  segment_ = make_pool<std::int32_t>(voxels, "observation grid");
+  segment_confidence_ = make_pool<std::int16_t>(voxels, "observation grid");
+  has_refined_kd_ = make_pool<bool>(voxels, "observation grid");
   block_last_frame_ = std::make_unique<std::atomic<int>[]>(hash_.capacity());
   for (std::size_t i = 0; i < hash_.capacity(); ++i) block_last_frame_[i] = -1;
 }

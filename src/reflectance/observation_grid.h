@@ -27,6 +27,7 @@
 
 #include "core/camera.h"
 #include "core/image.h"
+#include "core/pool_memory.h"
 #include "fusion/tsdf_sampler.h"
 #include "fusion/tsdf_volume.h"
 #include "fusion/voxel_block_hash.h"
@@ -111,9 +112,6 @@ class ObservationGrid {
   }
 
  private:
-  template <class T>
-  using Pool = std::unique_ptr<T[], void (*)(void*)>;
-
   int voxel_index(int block, const Eigen::Vector3i& local) const {
     return block * voxels_per_block_ + (local.z() * side_ + local.y()) * side_ + local.x();
   }
@@ -132,16 +130,16 @@ class ObservationGrid {
   std::vector<int> frame_blocks_;
 
   // Structure-of-arrays voxel pools (zero-initialised, committed on first touch).
-  Pool<Observation> observations_;
-  Pool<NearestObservation> nearest_;  // parallel to observations_
-  Pool<std::uint8_t> observation_count_;
-  Pool<Eigen::Vector3f> position_, normal_, refined_kd_;
-  Pool<int> next_refresh_frame_;       // frame of the next surface refresh
-  Pool<std::uint8_t> surface_misses_;  // refreshes in a row that found no surface
-  Pool<bool> has_surface_;
-  Pool<std::int32_t> segment_;
-  Pool<std::int16_t> segment_confidence_;
-  Pool<bool> has_refined_kd_;
+  PoolArray<Observation> observations_;
+  PoolArray<NearestObservation> nearest_;  // parallel to observations_
+  PoolArray<std::uint8_t> observation_count_;
+  PoolArray<Eigen::Vector3f> position_, normal_, refined_kd_;
+  PoolArray<int> next_refresh_frame_;       // frame of the next surface refresh
+  PoolArray<std::uint8_t> surface_misses_;  // refreshes in a row that found no surface
+  PoolArray<bool> has_surface_;
+  PoolArray<std::int32_t> segment_;
+  PoolArray<std::int16_t> segment_confidence_;
+  PoolArray<bool> has_refined_kd_;
 
   std::vector<VisibleVoxel> visible_;
 };
