@@ -34,6 +34,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// --specular's values: the HemiCNN's ks, alpha alone (the paper), or with the lobe fit.
+constexpr const char* kHemiCnnOnly = "hemicnn";
+constexpr const char* kHemiCnnAndFit = "hemicnn+fit";
+const char* specular_name(const reflectance::SpecularParams& params) {
+  return params.fit_lobe ? kHemiCnnAndFit : kHemiCnnOnly;
+}
+
 struct ReconstructOptions {
   std::string sequence;
   std::string output;
@@ -210,7 +217,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"voxel_m", options.params.geometry.volume.voxel_size_m},
          {"observations_per_voxel", options.params.observations.observations_per_voxel},
          {"albedo_average", reflectance::albedo_average_name(options.params.albedo_average)},
-         {"specular", options.params.specular.fit_lobe ? "hemicnn+fit" : "hemicnn"},
+         {"specular", specular_name(options.params.specular)},
          {"ground_truth_poses", options.params.geometry.use_ground_truth_poses},
          {"ground_truth_segmentation", options.ground_truth_segmentation},
          {"exposure", options.params.exposure},
@@ -292,12 +299,12 @@ void register_reconstruct_command(CLI::App& app) {
       ->add_option_function<std::string>(
           "--specular",
           [options](const std::string& name) {
-            options->params.specular.fit_lobe = name == "hemicnn+fit";
+            options->params.specular.fit_lobe = name == kHemiCnnAndFit;
           },
           "Each frame's ks and alpha per segment: the HemiCNN's (the paper), or a photometric "
           "fit of the Ward lobe to the same voxels' observations where the lobe explains them")
-      ->check(CLI::IsMember({"hemicnn", "hemicnn+fit"}))
-      ->default_str(params.specular.fit_lobe ? "hemicnn+fit" : "hemicnn");
+      ->check(CLI::IsMember({kHemiCnnOnly, kHemiCnnAndFit}))
+      ->default_str(specular_name(params.specular));
   command->add_option("--seed", params.specular.seed, "Seed of the voxel sampling")
       ->capture_default_str();
   command->add_option("--report", options->report,

@@ -14,6 +14,12 @@
 namespace glint::reflectance {
 namespace {
 
+// A per-voxel (or per-observation) pool; its errors name the grid.
+template <class T>
+PoolArray<T> voxel_pool(std::size_t count) {
+  return make_pool<T>(count, "observation grid");
+}
+
 // Asks for the cache lines of [p, p + bytes) ahead of use.
 void prefetch_lines(const void* p, std::size_t bytes) {
   constexpr std::size_t kLine = 64;
@@ -79,20 +85,18 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
   if (params.surface_retry_doublings < 0 || params.surface_retry_doublings > 8)
     throw Error("observation grid", "surface_retry_doublings", "must be in 0..8");
   const std::size_t voxels = hash_.capacity() * voxels_per_block_;
-  observations_ =
-      make_pool<Observation>(voxels * params.observations_per_voxel, "observation grid");
-  nearest_ =
-      make_pool<NearestObservation>(voxels * params.observations_per_voxel, "observation grid");
-  observation_count_ = make_pool<std::uint8_t>(voxels, "observation grid");
-  position_ = make_pool<Eigen::Vector3f>(voxels, "observation grid");
-  normal_ = make_pool<Eigen::Vector3f>(voxels, "observation grid");
-  refined_kd_ = make_pool<Eigen::Vector3f>(voxels, "observation grid");
-  next_refresh_frame_ = make_pool<int>(voxels, "observation grid");
-  surface_misses_ = make_pool<std::uint8_t>(voxels, "observation grid");
-  has_surface_ = make_pool<bool>(voxels, "observation grid");
-  segment_ = make_pool<std::int32_t>(voxels, "observation grid");
-  segment_confidence_ = make_pool<std::int16_t>(voxels, "observation grid");
-  has_refined_kd_ = make_pool<bool>(voxels, "observation grid");
+  observations_ = voxel_pool<Observation>(voxels * params.observations_per_voxel);
+  nearest_ = voxel_pool<NearestObservation>(voxels * params.observations_per_voxel);
+  observation_count_ = voxel_pool<std::uint8_t>(voxels);
+  position_ = voxel_pool<Eigen::Vector3f>(voxels);
+  normal_ = voxel_pool<Eigen::Vector3f>(voxels);
+  refined_kd_ = voxel_pool<Eigen::Vector3f>(voxels);
+  next_refresh_frame_ = voxel_pool<int>(voxels);
+  surface_misses_ = voxel_pool<std::uint8_t>(voxels);
+  has_surface_ = voxel_pool<bool>(voxels);
+  segment_ = voxel_pool<std::int32_t>(voxels);
+  segment_confidence_ = voxel_pool<std::int16_t>(voxels);
+  has_refined_kd_ = voxel_pool<bool>(voxels);
   block_last_frame_ = std::make_unique<std::atomic<int>[]>(hash_.capacity());
   for (std::size_t i = 0; i < hash_.capacity(); ++i) block_last_frame_[i] = -1;
 }
