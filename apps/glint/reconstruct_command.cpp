@@ -41,6 +41,14 @@ const char* specular_name(const reflectance::SpecularParams& params) {
   return params.fit_lobe ? kHemiCnnAndFit : kHemiCnnOnly;
 }
 
+// --normals' values: the observation voxels' normals from the TSDF gradient at their surface
+// point, or from the plane through their neighbours' surface points.
+constexpr const char* kGradientNormals = "gradient";
+constexpr const char* kPlaneNormals = "plane";
+const char* normals_name(const reflectance::ObservationGridParams& params) {
+  return params.normal_from_neighbours ? kPlaneNormals : kGradientNormals;
+}
+
 struct ReconstructOptions {
   std::string sequence;
   std::string output;
@@ -218,6 +226,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"observations_per_voxel", options.params.observations.observations_per_voxel},
          {"albedo_average", reflectance::albedo_average_name(options.params.albedo_average)},
          {"specular", specular_name(options.params.specular)},
+         {"normals", normals_name(options.params.observations)},
          {"ground_truth_poses", options.params.geometry.use_ground_truth_poses},
          {"ground_truth_segmentation", options.ground_truth_segmentation},
          {"exposure", options.params.exposure},
@@ -305,6 +314,17 @@ void register_reconstruct_command(CLI::App& app) {
           "fit of the Ward lobe to the same voxels' observations where the lobe explains them")
       ->check(CLI::IsMember({kHemiCnnOnly, kHemiCnnAndFit}))
       ->default_str(specular_name(params.specular));
+  command
+      ->add_option_function<std::string>(
+          "--normals",
+          [options](const std::string& name) {
+            options->params.observations.normal_from_neighbours = name == kPlaneNormals;
+          },
+          "Observation voxels' normals: the TSDF gradient at the surface point, or the plane "
+          "through the surface points of the voxel and its neighbours (steadier on flat faces, "
+          "where a sharp highlight needs the normal to a fraction of a degree)")
+      ->check(CLI::IsMember({kGradientNormals, kPlaneNormals}))
+      ->default_str(normals_name(params.observations));
   command->add_option("--seed", params.specular.seed, "Seed of the voxel sampling")
       ->capture_default_str();
   command->add_option("--report", options->report,

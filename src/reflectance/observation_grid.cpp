@@ -2,9 +2,11 @@
 
 #include <tbb/enumerable_thread_specific.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "core/error.h"
@@ -26,6 +28,28 @@ void prefetch_lines(const void* p, std::size_t bytes) {
   const auto* first = static_cast<const char*>(p);
   for (std::size_t offset = 0; offset < bytes; offset += kLine) __builtin_prefetch(first + offset);
   if (bytes > 0) __builtin_prefetch(first + bytes - 1);
+}
+
+// The normal of the least-squares plane through `count` points, on `reference`'s side; nullopt for
+// fewer than five points or points along a line (a thin strip of surface fixes no plane).
+std::optional<Eigen::Vector3f> fit_plane(const Eigen::Vector3f* points, int count,
+                                         const Eigen::Vector3f& reference) {
+  constexpr int kMinPoints = 5;
+  if (count < kMinPoints) return std::nullopt;
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  Eigen::Matrix3f products = Eigen::Matrix3f::Zero();
+  for (int i = 0; i < count; ++i) {
+    sum += points[i];
+    products += points[i] * points[i].transpose();
+  }
+  const Eigen::Vector3f mean = sum / float(count);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> solver;
+  solver.computeDirect(products / float(count) - mean * mean.transpose());  // closed form
+  const Eigen::Vector3f spread = solver.eigenvalues();                      // ascending
+  if (!(spread[0] <= 0.1f * spread[1])) return std::nullopt;
+  Eigen::Vector3f normal = solver.eigenvectors().col(0).normalized();
+  if (normal.dot(reference) < 0) normal = -normal;
+  return normal;
 }
 
 Eigen::Vector3i floor_div(const Eigen::Vector3i& v, int side) {
@@ -190,6 +214,49 @@ void ObservationGrid::refresh_surface(int v, const Eigen::Vector3f& centre, int 
   normal_[v] = gradient.normalized();
 }
 
+void ObservationGrid::fit_normals_to_neighbours(std::size_t slot, int frame) {
+  const int block = frame_blocks_[slot];
+  const int first_voxel = block * voxels_per_block_;
+  const auto refreshed = [&](int v) {  // in this frame's collect(), and found the surface
+    return has_surface_[v] && next_refresh_frame_[v] == frame + params_.geometry_refresh_frames;
+  };
+  int first = 0;
+  while (first < voxels_per_block_ && !refreshed(first_voxel + first)) ++first;
+  if (first == voxels_per_block_) return;  // the 27 block look-ups would serve no voxel
+
+  // The 3^3 blocks around this one, looked up once for all of its voxels.
+  const Eigen::Vector3i block_coordinates = hash_.block(block);
+  std::array<int, 27> around;
+  for (int i = 0; i < 27; ++i)
+    around[i] =
+        hash_.find(block_coordinates + Eigen::Vector3i(i % 3 - 1, (i / 3) % 3 - 1, i / 9 - 1));
+  const Eigen::Vector3i origin = (block_coordinates - Eigen::Vector3i::Ones()) * side_;
+  // Neighbours more than 30 degrees off the voxel's tangent plane belong to another face.
+  const float max_off_plane = std::sin(float(M_PI) / 6);
+
+  for (int local = first; local < voxels_per_block_; ++local) {
+    const int v = first_voxel + local;
+    if (!refreshed(v)) continue;
+    const Eigen::Vector3f p = position_[v], gradient_normal = normal_[v];
+    const Eigen::Vector3i centre = voxel_coordinates(v);
+    std::array<Eigen::Vector3f, 27> points;  // relative to p: better conditioned
+    int count = 0;
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const Eigen::Vector3i voxel = centre + Eigen::Vector3i(dx, dy, dz) - origin;
+          const Eigen::Vector3i b = voxel / side_;  // within the 3^3 blocks: non-negative
+          const int index = around[(b.z() * 3 + b.y()) * 3 + b.x()];
+          if (index < 0) continue;
+          const int u = voxel_index(index, voxel - b * side_);
+          if (!has_surface_[u]) continue;
+          const Eigen::Vector3f d = position_[u] - p;
+          if (std::fabs(d.dot(gradient_normal)) <= max_off_plane * d.norm()) points[count++] = d;
+        }
+    if (const auto normal = fit_plane(points.data(), count, gradient_normal)) normal_[v] = *normal;
+  }
+}
+
 const std::vector<VisibleVoxel>& ObservationGrid::collect(
     const ImageF& depth_m, const ImageF& colour, const Intrinsics& intrinsics,
     const Pose& camera_to_world, float exposure, const fusion::TsdfVolume& geometry, int frame) {
@@ -270,6 +337,10 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
       }
     }
   });
+  // After all refreshes: a plane fit reads its neighbours' surface points, which the pass above
+  // may be writing on another thread.
+  if (params_.normal_from_neighbours)
+    parallel_for(blocks, [&](std::size_t slot) { fit_normals_to_neighbours(slot, frame); });
   std::erase_if(visible_, [](const VisibleVoxel& seen) { return seen.voxel < 0; });
   return visible_;
 }

@@ -7,7 +7,9 @@
 //  - a surface point and normal, taken from the fused TSDF: the voxel centre moved onto the zero
 //    level set along the SDF gradient (two Newton steps), refreshed every few frames while the
 //    geometry converges; voxels the surface does not pass through have none, and are retried
-//    ever less often;
+//    ever less often. The normal is the plane through the surface points of the voxel and its
+//    neighbours (see normal_from_neighbours); the TSDF gradient only where too few neighbours
+//    have one;
 //  - at most `observations_per_voxel` (m = 30) observations: linear radiance (pixel / exposure)
 //    and the unit voxel-to-camera direction, with the most-similar-pair replacement of
 //    reflectance/observation.h;
@@ -51,6 +53,12 @@ struct ObservationGridParams {
   double depth_tolerance_sigmas = 3;  // ... this many Kinect sigma(z) (render/sensor.h)
   double min_view_cosine = 0.1;       // normal . direction of an accepted observation
   int geometry_refresh_frames = 8;    // surface point / normal recomputed this often
+  // The normal as the least-squares plane through the surface points of the voxel and its (up
+  // to 26) neighbours, instead of the TSDF gradient at the point. The gradient of a TSDF fused
+  // from millimetre-quantised depth tilts by 1-3 degrees on a flat face, which puts a sharp
+  // highlight's predicted lobe (alpha 0.05 is 3 degrees wide) beside the observed one; the
+  // zero crossings are far steadier than the slopes between them.
+  bool normal_from_neighbours = true;
   // A voxel without surface is retried after geometry_refresh_frames, then twice, four times ...
   // as long, doubling at most this many times.
   int surface_retry_doublings = 3;
@@ -119,6 +127,9 @@ class ObservationGrid {
                 int frame);
   void refresh_surface(int v, const Eigen::Vector3f& centre, int frame,
                        fusion::TsdfSampler& sampler);
+  // Replaces the gradient normals of the voxels of frame_blocks_[slot] refreshed in `frame` by
+  // the plane through their neighbours' surface points (ObservationGridParams).
+  void fit_normals_to_neighbours(std::size_t slot, int frame);
   // Prefetches the per-voxel state collect() reads first for the voxels of `block`.
   void prefetch_voxel_state(int block) const;
 

@@ -4,6 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
 #include "core/error.h"
 #include "fusion/integrate.h"
 #include "support/error_of.h"
@@ -116,6 +120,111 @@ TEST(ObservationGrid, VoxelsWithoutSurfaceAreRetriedEverLessOften) {
     else
       EXPECT_GT(visible.size(), 50u);
   }
+}
+
+// Pools for the metre-sized surfaces of the normal tests.
+fusion::VolumeParams room_geometry_params() {
+  fusion::VolumeParams params = geometry_params();
+  params.block_capacity = 1 << 16;
+  return params;
+}
+
+ObservationGridParams room_grid_params() {
+  ObservationGridParams params = grid_params();
+  params.voxel_capacity = 1 << 17;
+  return params;
+}
+
+// A plane through (0, 0, depth_m) with unit normal n (facing the camera), as a depth image
+// rounded to whole millimetres like a 16-bit depth PNG.
+ImageF quantised_plane_depth(const Eigen::Vector3f& n, float depth_m, const Intrinsics& camera,
+                             const Pose& camera_to_world) {
+  ImageF depth(camera.width, camera.height, 1);
+  const Eigen::Matrix3f rotation = camera_to_world.linear().cast<float>();
+  const Eigen::Vector3f origin = camera_to_world.translation().cast<float>();
+  const float offset = n.dot(Eigen::Vector3f(0, 0, depth_m));
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x) {
+      const Eigen::Vector3f ray(float((x - camera.cx) / camera.fx),
+                                float((y - camera.cy) / camera.fy), 1.0f);  // z = 1
+      const float z = (offset - n.dot(origin)) / n.dot(rotation * ray);
+      depth.at(x, y, 0) = z > 1.5f && z < 4.0f ? std::round(z * 1000.0f) / 1000.0f : 0.0f;
+    }
+  return depth;
+}
+
+// Median angle, in degrees, between the normals of the surfaced voxels and n.
+double median_normal_error_deg(const ObservationGrid& grid, const Eigen::Vector3f& n) {
+  std::vector<double> errors;
+  for (int v = 0; v < int(grid.voxel_count()); ++v)
+    if (grid.has_surface(v))
+      errors.push_back(std::acos(std::clamp(double(grid.normal(v).dot(n)), -1.0, 1.0)) * 180 /
+                       M_PI);
+  EXPECT_GT(errors.size(), 100u);
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+  return errors[errors.size() / 2];
+}
+
+TEST(ObservationGrid, PlaneNormalsAreSteadierThanTheGradientOnQuantisedDepth) {
+  // A tilted floor-like plane 2.5 m away, seen from a camera sliding sideways, its depth in
+  // whole millimetres: the TSDF's gradient tilts with the quantisation steps, while the zero
+  // crossings of neighbouring voxels stay on the plane.
+  const Intrinsics camera{160, 120, 365.0, 365.0, 79.5, 59.5};  // ~7 mm pixels at 2.5 m
+  const Eigen::Vector3f n = Eigen::Vector3f(0.35f, -0.6f, -1.0f).normalized();
+  double error[2];
+  for (const bool plane : {false, true}) {
+    fusion::TsdfVolume geometry(room_geometry_params());
+    fusion::VisibleBlocks blocks;
+    ObservationGridParams params = room_grid_params();
+    params.normal_from_neighbours = plane;
+    ObservationGrid grid(params);
+    const ImageF colour(camera.width, camera.height, 3, 0.5f);
+    for (int frame = 0; frame < 10; ++frame) {
+      Pose pose = Pose::Identity();
+      pose.translation() = Eigen::Vector3d(0.01 * frame, 0.004 * frame, 0);
+      const ImageF depth = quantised_plane_depth(n, 2.5f, camera, pose);
+      fusion::integrate(geometry, depth, colour, camera, pose, blocks);
+      grid.collect(depth, colour, camera, pose, 1.0f, geometry, frame);
+    }
+    error[plane] = median_normal_error_deg(grid, n);
+  }
+  EXPECT_LT(error[true], 0.5 * error[false]) << "gradient " << error[false] << " deg";
+  EXPECT_LT(error[true], 0.5) << "degrees";
+}
+
+TEST(ObservationGrid, PlaneNormalsDoNotBlendTheFacesOfACrease) {
+  // A room's floor (y = -0.51, normal +y) meeting its back wall (z = 2.01, normal -z), seen from
+  // inside: a voxel near the crease has neighbours on both faces and must fit its own.
+  fusion::TsdfVolume geometry(room_geometry_params());
+  fusion::VisibleBlocks blocks;
+  ObservationGrid grid(room_grid_params());
+  const Intrinsics camera{160, 120, 200.0, 200.0, 79.5, 59.5};
+  ImageF depth(camera.width, camera.height, 1);
+  const ImageF colour(camera.width, camera.height, 3, 0.5f);
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x) {
+      const float ray_y = float((y - camera.cy) / camera.fy);
+      const float floor_z = ray_y > 0 ? 0.51f / ray_y : INFINITY;  // image y points down
+      depth.at(x, y, 0) = std::min(2.01f, floor_z);
+    }
+  // The floor is y = +0.51 in camera coordinates (y down); its normal faces the camera: -y.
+  const Eigen::Vector3f floor_normal(0, -1, 0), wall_normal(0, 0, -1);
+  fusion::integrate(geometry, depth, colour, camera, Pose::Identity(), blocks);
+  for (int frame = 0; frame < 2; ++frame)
+    grid.collect(depth, colour, camera, Pose::Identity(), 1.0f, geometry, frame);
+  int checked = 0;
+  for (int v = 0; v < int(grid.voxel_count()); ++v) {
+    if (!grid.has_surface(v)) continue;
+    const Eigen::Vector3f p = grid.position(v);
+    const float to_floor = std::fabs(p.y() - 0.51f), to_wall = std::fabs(p.z() - 2.01f);
+    const float to_crease = std::hypot(to_floor, to_wall);
+    if (to_crease < 0.015f || to_crease > 0.04f) continue;  // within a neighbour's reach
+    const Eigen::Vector3f own = to_floor < to_wall ? floor_normal : wall_normal;
+    EXPECT_GT(grid.normal(v).dot(own), std::cos(2.0f * float(M_PI) / 180))
+        << "voxel at " << p.transpose();
+    ++checked;
+  }
+  EXPECT_GT(checked, 20);
 }
 
 TEST(ObservationGrid, BadInputsAndExhaustion) {
