@@ -156,8 +156,8 @@ void run_reconstruct(ReconstructOptions options) {
       if (result.geometry.integrated && (evaluate || render)) {
         watch.restart();
         const Pose& pose = result.geometry.camera_to_world;
-        const fusion::SurfaceView view =
-            fusion::raycast(pipeline.geometry(), sequence.intrinsics, pose);
+        const fusion::SurfaceView view = fusion::raycast(
+            pipeline.geometry(), sequence.intrinsics, pose, fusion::RaycastNormals::from_gradient);
         const reflectance::MaterialMaps maps = reflectance::render_material_maps(
             view, pose, pipeline.observations(), pipeline.materials(), pipeline.lights(),
             pipeline.exposure());
@@ -176,7 +176,8 @@ void run_reconstruct(ReconstructOptions options) {
     ProgressBar progress("views", views.size());
     for (std::size_t k = 0; k < views.size(); ++k) {
       const fusion::SurfaceView view =
-          fusion::raycast(pipeline.geometry(), sequence.intrinsics, views[k].pose);
+          fusion::raycast(pipeline.geometry(), sequence.intrinsics, views[k].pose,
+                          fusion::RaycastNormals::from_gradient);
       const reflectance::MaterialMaps maps = reflectance::render_material_maps(
           view, views[k].pose, pipeline.observations(), pipeline.materials(), pipeline.lights(),
           pipeline.exposure());

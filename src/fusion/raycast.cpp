@@ -116,10 +116,23 @@ float march(TsdfSampler& sampler, const Eigen::Vector3f& origin, const Eigen::Ve
   return 0;
 }
 
+// Whether the central differences of normals_from_points() at (x, y) straddle a depth edge:
+// a neighbour without a hit, or a second difference of depth above 1 % of it (a plane's depth
+// has almost none; a silhouette's jumps by the gap between the surfaces).
+bool at_depth_edge(const ImageF& depth, int x, int y) {
+  if (x == 0 || y == 0 || x == depth.width() - 1 || y == depth.height() - 1) return true;
+  const float z = depth.at(x, y, 0);
+  const float left = depth.at(x - 1, y, 0), right = depth.at(x + 1, y, 0);
+  const float up = depth.at(x, y - 1, 0), down = depth.at(x, y + 1, 0);
+  if (!(left > 0 && right > 0 && up > 0 && down > 0)) return true;
+  const float limit = 0.01f * z;
+  return std::fabs(left + right - 2 * z) > limit || std::fabs(up + down - 2 * z) > limit;
+}
+
 }  // namespace
 
 SurfaceView raycast(const TsdfVolume& volume, const Intrinsics& intrinsics,
-                    const Pose& camera_to_world) {
+                    const Pose& camera_to_world, RaycastNormals normals) {
   const int width = intrinsics.width, height = intrinsics.height;
   SurfaceView view{ImageF(width, height, 1), ImageF(width, height, 3, kNaN), ImageF(),
                    ImageF(width, height, 3)};
@@ -148,6 +161,23 @@ SurfaceView raycast(const TsdfVolume& volume, const Intrinsics& intrinsics,
     }
   });
   view.normals = normals_from_points(view.points_m, camera_to_world.translation());
+  if (normals == RaycastNormals::from_gradient)
+    parallel_for(static_cast<std::size_t>(height), [&](std::size_t row) {
+      TsdfSampler sampler(volume);
+      const int y = static_cast<int>(row);
+      for (int x = 0; x < width; ++x) {
+        if (!(view.depth_m.at(x, y, 0) > 0) || !at_depth_edge(view.depth_m, x, y)) continue;
+        const Eigen::Vector3f p(view.points_m.at(x, y, 0), view.points_m.at(x, y, 1),
+                                view.points_m.at(x, y, 2));
+        float sdf;
+        Eigen::Vector3f gradient;
+        // Where a stencil voxel is unobserved, the points' normal stays.
+        if (!sampler.trilinear_with_gradient(p, sdf, gradient) || !(gradient.norm() > 0)) continue;
+        Eigen::Vector3f n = gradient.normalized();
+        if (n.dot(origin - p) < 0) n = -n;
+        for (int c = 0; c < 3; ++c) view.normals.at(x, y, c) = n[c];
+      }
+    });
   return view;
 }
 

@@ -20,7 +20,14 @@ struct SurfaceView {
   ImageF colour;    // 3 channels, linear RGB of the nearest voxel, 0 = no hit
 };
 
+// Where a view's normals come from. from_points: the cross product of the neighbouring pixels'
+// points (cheap; what tracking uses). from_gradient: the same, except beside a depth edge, where
+// the neighbours lie on another surface (a silhouette against the background) and their cross
+// product is no normal of either: there the TSDF's gradient at the hit (renderings use this).
+enum class RaycastNormals { from_points, from_gradient };
+
 SurfaceView raycast(const TsdfVolume& volume, const Intrinsics& intrinsics,
-                    const Pose& camera_to_world);
+                    const Pose& camera_to_world,
+                    RaycastNormals normals = RaycastNormals::from_points);
 
 }  // namespace glint::fusion

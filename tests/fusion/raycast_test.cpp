@@ -1,26 +1,43 @@
-// Ray casting an analytic TSDF: depth, normals and colour of a sphere seen head-on.
+// Ray casting an analytic TSDF: depth, normals and colour of a sphere seen head-on, and the
+// normals at its silhouette against a wall.
 #include "fusion/raycast.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
+#include <memory>
+#include <utility>
 
 #include "fusion_test_support.h"
 
 namespace glint::fusion {
 namespace {
 
-TEST(Raycast, SphereDepthAndNormalsMatchTheAnalyticSurface) {
+const Intrinsics kCamera{40, 30, 40.0, 40.0, 19.5, 14.5};
+const Eigen::Vector3d kCentre(0, 0, 1.0);  // of the sphere
+constexpr double kRadius = 0.3;
+
+// A 1 cm TSDF of `sdf` within extent_m of the origin, 4 cm around its zero level.
+std::unique_ptr<TsdfVolume> analytic_volume(
+    const std::function<double(const Eigen::Vector3d&)>& sdf, double extent_m) {
   VolumeParams params;
   params.voxel_size_m = 0.01;
-  params.block_capacity = 20000;
-  TsdfVolume volume(params);
-  const Eigen::Vector3d centre(0, 0, 1.0);
-  const double radius = 0.3;
-  test::fill_analytic(
-      volume, [&](const Eigen::Vector3d& p) { return (p - centre).norm() - radius; }, 1.4, 0.04);
-  const Intrinsics camera{40, 30, 40.0, 40.0, 19.5, 14.5};
-  const SurfaceView view = raycast(volume, camera, Pose::Identity());
+  params.block_capacity = 40000;
+  auto volume = std::make_unique<TsdfVolume>(params);
+  test::fill_analytic(*volume, sdf, extent_m, 0.04);
+  return volume;
+}
+
+double sphere(const Eigen::Vector3d& p) { return (p - kCentre).norm() - kRadius; }
+
+TEST(Raycast, SphereDepthAndNormalsMatchTheAnalyticSurface) {
+  const auto volume = analytic_volume(sphere, 1.4);
+  const Intrinsics& camera = kCamera;
+  const Eigen::Vector3d& centre = kCentre;
+  const double radius = kRadius;
+  const SurfaceView view = raycast(*volume, camera, Pose::Identity());
   int hits = 0;
   for (int y = 1; y < camera.height - 1; ++y) {
     for (int x = 1; x < camera.width - 1; ++x) {
@@ -45,6 +62,41 @@ TEST(Raycast, SphereDepthAndNormalsMatchTheAnalyticSurface) {
   }
   EXPECT_GT(hits, 200);
   EXPECT_EQ(view.depth_m.at(0, 0, 0), 0.0f);  // the corner ray misses
+}
+
+TEST(Raycast, GradientNormalsHoldAtSilhouettes) {
+  // The sphere in front of a wall: at its silhouette the neighbouring pixels lie on the wall, so
+  // the points' cross product is no normal of either; the TSDF's gradient is the sphere's own.
+  const double wall_z = 1.6;
+  const auto volume = analytic_volume(
+      [&](const Eigen::Vector3d& p) { return std::min(sphere(p), wall_z - p.z()); }, 1.8);
+  const Intrinsics& camera = kCamera;
+  const SurfaceView points = raycast(*volume, camera, Pose::Identity());
+  const SurfaceView gradient =
+      raycast(*volume, camera, Pose::Identity(), RaycastNormals::from_gradient);
+  const auto normal = [](const SurfaceView& view, int x, int y) {
+    return Eigen::Vector3d(view.normals.at(x, y, 0), view.normals.at(x, y, 1),
+                           view.normals.at(x, y, 2));
+  };
+  int silhouette = 0;
+  double worst_points = 1;  // the points' normals at the silhouette
+  for (int y = 1; y < camera.height - 1; ++y)
+    for (int x = 1; x < camera.width - 1; ++x) {
+      const double depth = points.depth_m.at(x, y, 0);
+      if (!(depth > 0) || depth > wall_z - 0.05) continue;  // the sphere's pixels only
+      bool beside_wall = false;
+      for (const auto& [dx, dy] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}})
+        beside_wall = beside_wall || points.depth_m.at(x + dx, y + dy, 0) > wall_z - 0.05;
+      EXPECT_EQ(gradient.depth_m.at(x, y, 0), depth) << "only the normals differ";
+      const Eigen::Vector3d p = depth * camera.ray(x, y);
+      const Eigen::Vector3d truth = (p - kCentre).normalized();
+      EXPECT_GT(normal(gradient, x, y).dot(truth), 0.95) << x << "," << y;
+      if (!beside_wall) continue;
+      ++silhouette;
+      worst_points = std::min(worst_points, normal(points, x, y).dot(truth));
+    }
+  EXPECT_GT(silhouette, 20);
+  EXPECT_LT(worst_points, 0.8) << "the case the gradient is for";
 }
 
 }  // namespace
