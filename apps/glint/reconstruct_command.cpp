@@ -49,6 +49,17 @@ const char* normals_name(const reflectance::ObservationGridParams& params) {
   return params.normal_from_neighbours ? kPlaneNormals : kGradientNormals;
 }
 
+// The model re-rendered from `pose`: ray cast (with gradient normals at silhouettes) and shaded
+// with the pipeline's materials and lights.
+reflectance::MaterialMaps render_model(const reflectance::ReflectancePipeline& pipeline,
+                                       const Intrinsics& intrinsics, const Pose& pose) {
+  const fusion::SurfaceView view =
+      fusion::raycast(pipeline.geometry(), intrinsics, pose, fusion::RaycastNormals::from_gradient);
+  return reflectance::render_material_maps(view, pose, pipeline.observations(),
+                                           pipeline.materials(), pipeline.lights(),
+                                           pipeline.exposure());
+}
+
 struct ReconstructOptions {
   std::string sequence;
   std::string output;
@@ -155,12 +166,8 @@ void run_reconstruct(ReconstructOptions options) {
       if (!result.geometry.integrated) ++lost;
       if (result.geometry.integrated && (evaluate || render)) {
         watch.restart();
-        const Pose& pose = result.geometry.camera_to_world;
-        const fusion::SurfaceView view = fusion::raycast(
-            pipeline.geometry(), sequence.intrinsics, pose, fusion::RaycastNormals::from_gradient);
-        const reflectance::MaterialMaps maps = reflectance::render_material_maps(
-            view, pose, pipeline.observations(), pipeline.materials(), pipeline.lights(),
-            pipeline.exposure());
+        const reflectance::MaterialMaps maps =
+            render_model(pipeline, sequence.intrinsics, result.geometry.camera_to_world);
         if (evaluate) evaluation.add_frame(int(i), maps, *truth, frame.colour);
         if (render) write_frame_pictures(options.output, int(i), frame.colour, maps);
         command_timings.add("evaluate", watch.elapsed_ms());
@@ -175,12 +182,8 @@ void run_reconstruct(ReconstructOptions options) {
     fs::create_directories(fs::path(options.output) / "views");
     ProgressBar progress("views", views.size());
     for (std::size_t k = 0; k < views.size(); ++k) {
-      const fusion::SurfaceView view =
-          fusion::raycast(pipeline.geometry(), sequence.intrinsics, views[k].pose,
-                          fusion::RaycastNormals::from_gradient);
-      const reflectance::MaterialMaps maps = reflectance::render_material_maps(
-          view, views[k].pose, pipeline.observations(), pipeline.materials(), pipeline.lights(),
-          pipeline.exposure());
+      const reflectance::MaterialMaps maps =
+          render_model(pipeline, sequence.intrinsics, views[k].pose);
       write_view_pictures((fs::path(options.output) / "views").string(), int(k), maps);
       progress.advance();
     }

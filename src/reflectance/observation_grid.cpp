@@ -208,7 +208,7 @@ void ObservationGrid::refresh_surface(int v, const Eigen::Vector3f& centre, int 
   const int misses =
       found ? 0 : std::min(surface_misses_[v] + 1, params_.surface_retry_doublings + 1);
   surface_misses_[v] = std::uint8_t(misses);
-  next_refresh_frame_[v] = frame + (params_.geometry_refresh_frames << std::max(0, misses - 1));
+  next_refresh_frame_[v] = next_refresh(frame, misses);
   if (!found) return;
   position_[v] = p;
   normal_[v] = gradient.normalized();
@@ -218,7 +218,7 @@ void ObservationGrid::fit_normals_to_neighbours(std::size_t slot, int frame) {
   const int block = frame_blocks_[slot];
   const int first_voxel = block * voxels_per_block_;
   const auto refreshed = [&](int v) {  // in this frame's collect(), and found the surface
-    return has_surface_[v] && next_refresh_frame_[v] == frame + params_.geometry_refresh_frames;
+    return has_surface_[v] && next_refresh_frame_[v] == next_refresh(frame, 0);
   };
   int first = 0;
   while (first < voxels_per_block_ && !refreshed(first_voxel + first)) ++first;

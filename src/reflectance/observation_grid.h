@@ -22,6 +22,7 @@
 // measured one (the visibility / occlusion test). Pools are allocated once; their memory is
 // committed as voxels are used.
 #include <Eigen/Core>
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -127,6 +128,11 @@ class ObservationGrid {
                 int frame);
   void refresh_surface(int v, const Eigen::Vector3f& centre, int frame,
                        fusion::TsdfSampler& sampler);
+  // The frame after `frame` at which a voxel whose surface search has failed `misses` times in a
+  // row (0: found) is refreshed again.
+  int next_refresh(int frame, int misses) const {
+    return frame + (params_.geometry_refresh_frames << std::max(0, misses - 1));
+  }
   // Replaces the gradient normals of the voxels of frame_blocks_[slot] refreshed in `frame` by
   // the plane through their neighbours' surface points (ObservationGridParams).
   void fit_normals_to_neighbours(std::size_t slot, int frame);
