@@ -79,9 +79,9 @@ std::size_t voxel_capacity(const ObservationGridParams& params) {
 }  // namespace
 
 void ObservationGrid::prefetch_observations(int v) const {
-  const std::size_t first_slot = std::size_t(v) * params_.observations_per_voxel;
-  prefetch_lines(observations_.get() + first_slot, observation_count_[v] * sizeof(Observation));
-  prefetch_lines(nearest_.get() + first_slot, observation_count_[v] * sizeof(NearestObservation));
+  const std::size_t first = first_slot(v);
+  prefetch_lines(observations_.get() + first, observation_count_[v] * sizeof(Observation));
+  prefetch_lines(nearest_.get() + first, observation_count_[v] * sizeof(NearestObservation));
 }
 
 void ObservationGrid::prefetch_voxel_state(int block) const {
@@ -92,6 +92,7 @@ void ObservationGrid::prefetch_voxel_state(int block) const {
   prefetch_lines(position_.get() + first, voxels * sizeof(Eigen::Vector3f));
   prefetch_lines(normal_.get() + first, voxels * sizeof(Eigen::Vector3f));
   prefetch_lines(observation_count_.get() + first, voxels * sizeof(std::uint8_t));
+  prefetch_lines(observation_set_.get() + first, voxels * sizeof(std::int32_t));
 }
 
 ObservationGrid::ObservationGrid(const ObservationGridParams& params)
@@ -111,6 +112,8 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
   const std::size_t voxels = hash_.capacity() * voxels_per_block_;
   observations_ = voxel_pool<Observation>(voxels * params.observations_per_voxel);
   nearest_ = voxel_pool<NearestObservation>(voxels * params.observations_per_voxel);
+  observation_set_ = voxel_pool<std::int32_t>(voxels);
+  observation_sets_used_ = std::make_unique<std::atomic<std::int32_t>>(0);
   observation_count_ = voxel_pool<std::uint8_t>(voxels);
   position_ = voxel_pool<Eigen::Vector3f>(voxels);
   normal_ = voxel_pool<Eigen::Vector3f>(voxels);
@@ -329,10 +332,13 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
             inverse_exposure;
         observation.direction = voxel.direction;
         observation.frame = std::uint32_t(frame);
-        const std::size_t first_slot = std::size_t(v) * capacity;
-        observation_count_[v] = std::uint8_t(
-            insert_observation(observations_.get() + first_slot, nearest_.get() + first_slot,
-                               observation_count_[v], capacity, observation));
+        if (observation_set_[v] == 0)
+          observation_set_[v] =
+              1 + observation_sets_used_->fetch_add(1, std::memory_order_relaxed);
+        const std::size_t first = first_slot(v);
+        observation_count_[v] =
+            std::uint8_t(insert_observation(observations_.get() + first, nearest_.get() + first,
+                                            observation_count_[v], capacity, observation));
         visible_[slot * voxels_per_block_ + voxel.local] = {v, voxel.y * width + voxel.x};
       }
     }

@@ -46,8 +46,8 @@ struct ObservationGridParams {
   int observations_per_voxel = 30;  // m
   // Pool size; exhaustion is a glint::Error. 0: 2^20 voxels at 2 cm and above, and
   // 2 (0.02 / voxel_size_m)^2 times that below (a surface holds (0.02 / v)^2 times as many
-  // voxels, and finer grids leave more of each block empty). About 1.1 KB per voxel, committed
-  // as voxels are used.
+  // voxels, and finer grids leave more of each block empty). About 60 bytes per voxel and
+  // 1.1 KB of observation slots per voxel that has been observed, committed as they are used.
   std::size_t voxel_capacity = 0;
   int allocation_stride_px = 2;       // every n-th pixel of every n-th row allocates
   double depth_tolerance_m = 0.01;    // |measured - voxel depth| allowed, plus ...
@@ -96,9 +96,7 @@ class ObservationGrid {
   const Eigen::Vector3f& position(int v) const { return position_[v]; }
   const Eigen::Vector3f& normal(int v) const { return normal_[v]; }
   int observation_count(int v) const { return observation_count_[v]; }
-  const Observation* observations(int v) const {
-    return observations_.get() + std::size_t(v) * params_.observations_per_voxel;
-  }
+  const Observation* observations(int v) const { return observations_.get() + first_slot(v); }
   // Asks for voxel v's stored observations (about 1 KB, usually a cache miss) ahead of use.
   void prefetch_observations(int v) const;
   std::int32_t& segment(int v) { return segment_[v]; }
@@ -121,6 +119,12 @@ class ObservationGrid {
   }
 
  private:
+  // The first of voxel v's observation slots (0 while it has none: nothing reads them then).
+  std::size_t first_slot(int v) const {
+    return observation_set_[v] == 0
+               ? 0
+               : std::size_t(observation_set_[v] - 1) * params_.observations_per_voxel;
+  }
   int voxel_index(int block, const Eigen::Vector3i& local) const {
     return block * voxels_per_block_ + (local.z() * side_ + local.y()) * side_ + local.x();
   }
@@ -147,8 +151,13 @@ class ObservationGrid {
   std::vector<int> frame_blocks_;
 
   // Structure-of-arrays voxel pools (zero-initialised, committed on first touch).
+  // A voxel's m observation slots are taken from observations_ / nearest_ at its first
+  // observation, in the order voxels are first seen: most voxels of a block never see the
+  // surface, and slots reserved for every voxel had the kernel zeroing ~1 KB for each of them.
   PoolArray<Observation> observations_;
-  PoolArray<NearestObservation> nearest_;  // parallel to observations_
+  PoolArray<NearestObservation> nearest_;        // parallel to observations_
+  PoolArray<std::int32_t> observation_set_;      // 1 + its set of slots, 0 = none yet
+  std::unique_ptr<std::atomic<std::int32_t>> observation_sets_used_;
   PoolArray<std::uint8_t> observation_count_;
   PoolArray<Eigen::Vector3f> position_, normal_, refined_kd_;
   PoolArray<int> next_refresh_frame_;       // frame of the next surface refresh
