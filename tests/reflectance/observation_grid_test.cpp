@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include "core/error.h"
@@ -119,6 +121,44 @@ TEST(ObservationGrid, VoxelsWithoutSurfaceAreRetriedEverLessOften) {
       EXPECT_TRUE(visible.empty()) << "frame " << frame;
     else
       EXPECT_GT(visible.size(), 50u);
+  }
+}
+
+TEST(ObservationGrid, SettledSurfacesAreRefreshedEverLessOften) {
+  // The wall's surface points are found at frame 0 and stay put at their refresh at frame 8, so
+  // the next waits twice as long (frame 24). The wall moves 4 mm at frame 9: the points follow
+  // at frame 24, not before. Having moved, they are refreshed 8 frames later again (frame 32),
+  // and follow the wall's second 4 mm move at frame 25 there.
+  Wall wall;
+  fusion::VisibleBlocks blocks;
+  const std::array<float, 3> wall_z{1.0f, 1.004f, 1.008f};
+  const std::array<int, 3> wall_from_frame{0, 9, 25};
+  std::vector<ImageF> depth;
+  std::vector<std::unique_ptr<fusion::TsdfVolume>> geometry;
+  for (const float z : wall_z) {
+    depth.emplace_back(kCamera.width, kCamera.height, 1, z);
+    geometry.push_back(std::make_unique<fusion::TsdfVolume>(geometry_params()));
+    fusion::integrate(*geometry.back(), depth.back(), wall.colour, kCamera, Pose::Identity(),
+                      blocks);
+  }
+  ObservationGrid grid(grid_params());
+  ASSERT_EQ(grid.params().geometry_refresh_frames, 8);
+  const std::array<int, 3> surface_from_frame{0, 24, 32};
+  for (int frame = 0; frame <= 32; ++frame) {
+    const int shown = int(std::upper_bound(wall_from_frame.begin(), wall_from_frame.end(), frame) -
+                          wall_from_frame.begin()) -
+                      1;
+    const auto& visible = grid.collect(depth[shown], wall.colour, kCamera, Pose::Identity(), 1.0f,
+                                       *geometry[shown], frame);
+    ASSERT_GT(visible.size(), 50u) << "frame " << frame;
+    std::vector<float> z;
+    for (const VisibleVoxel& seen : visible) z.push_back(grid.position(seen.voxel).z());
+    std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
+    const int followed =
+        int(std::upper_bound(surface_from_frame.begin(), surface_from_frame.end(), frame) -
+            surface_from_frame.begin()) -
+        1;
+    EXPECT_NEAR(z[z.size() / 2], wall_z[followed], 1e-3f) << "frame " << frame;
   }
 }
 
