@@ -117,7 +117,6 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
   observations_ = voxel_pool<Observation>(voxels * params.observations_per_voxel);
   nearest_ = voxel_pool<NearestObservation>(voxels * params.observations_per_voxel);
   observation_set_ = voxel_pool<std::int32_t>(voxels);
-  observation_sets_used_ = std::make_unique<std::atomic<std::int32_t>>(0);
   observation_count_ = voxel_pool<std::uint8_t>(voxels);
   position_ = voxel_pool<Eigen::Vector3f>(voxels);
   normal_ = voxel_pool<Eigen::Vector3f>(voxels);
@@ -347,7 +346,7 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
         observation.direction = voxel.direction;
         observation.frame = std::uint32_t(frame);
         if (observation_set_[v] == 0)
-          observation_set_[v] = 1 + observation_sets_used_->fetch_add(1, std::memory_order_relaxed);
+          observation_set_[v] = 1 + observation_sets_used_.fetch_add(1, std::memory_order_relaxed);
         const std::size_t first = first_slot(v);
         observation_count_[v] =
             std::uint8_t(insert_observation(observations_.get() + first, nearest_.get() + first,

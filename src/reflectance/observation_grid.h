@@ -163,7 +163,7 @@ class ObservationGrid {
   PoolArray<Observation> observations_;
   PoolArray<NearestObservation> nearest_;    // parallel to observations_
   PoolArray<std::int32_t> observation_set_;  // 1 + its set of slots, 0 = none yet
-  std::unique_ptr<std::atomic<std::int32_t>> observation_sets_used_;
+  std::atomic<std::int32_t> observation_sets_used_{0};
   PoolArray<std::uint8_t> observation_count_;
   PoolArray<Eigen::Vector3f> position_, normal_, refined_kd_;
   PoolArray<int> next_refresh_frame_;        // frame of the next surface refresh
