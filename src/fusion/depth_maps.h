@@ -29,4 +29,11 @@ ImageF points_from_depth(const ImageF& depth_m, const Intrinsics& intrinsics);
 // camera centre, in the points' frame); NaN where a neighbour is missing.
 ImageF normals_from_points(const ImageF& points, const Eigen::Vector3d& viewpoint);
 
+// Edge-aware smoothing of a normal map: each normal becomes the normalised mean of the normals
+// of the pixels whose points lie within radius_m of its own point and whose normals are within
+// 60 degrees of its own (the same face of an edge). The window spans radius_m at the pixel's
+// depth (at most 8 pixels each way). Pixels without a normal stay without.
+ImageF smooth_normals(const ImageF& points, const ImageF& normals, const ImageF& depth_m,
+                      const Intrinsics& intrinsics, float radius_m);
+
 }  // namespace glint::fusion
