@@ -1,5 +1,7 @@
 #include "reflectance/material_maps.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "core/parallel.h"
@@ -32,16 +34,39 @@ bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& 
   const Eigen::Vector3i base(int(std::floor(g.x())), int(std::floor(g.y())),
                              int(std::floor(g.z())));
   const Eigen::Vector3f t = g - base.cast<float>();
-  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-  float weights = 0;
+  std::array<float, 8> weight, luminance;
+  std::array<Eigen::Vector3f, 8> albedo;
+  int corners = 0;
   for (int c = 0; c < 8; ++c) {
     const Eigen::Vector3i corner = base + Eigen::Vector3i(c & 1, (c >> 1) & 1, (c >> 2) & 1);
     const int v = grid.find_voxel(corner);
     if (v < 0 || grid.segment(v) != segment || !grid.has_refined_kd(v)) continue;
-    const float w = ((c & 1) ? t.x() : 1 - t.x()) * (((c >> 1) & 1) ? t.y() : 1 - t.y()) *
-                    (((c >> 2) & 1) ? t.z() : 1 - t.z());
-    sum += w * grid.refined_kd(v);
-    weights += w;
+    weight[corners] = ((c & 1) ? t.x() : 1 - t.x()) * (((c >> 1) & 1) ? t.y() : 1 - t.y()) *
+                      (((c >> 2) & 1) ? t.z() : 1 - t.z());
+    albedo[corners] = grid.refined_kd(v);
+    luminance[corners] = albedo[corners].mean();
+    ++corners;
+  }
+  if (corners == 0) return false;
+  // A voxel whose normal or surface point misses a crease predicts too little or too much
+  // irradiance, and its eq. (7) albedo comes out near 0 or 1. Among four or more corners, a
+  // minority (at most a quarter) whose mean albedo is more than half off the corners' median is
+  // left out; a texture edge through the cell splits the corners more evenly and stays.
+  std::array<float, 8> sorted = luminance;
+  std::nth_element(sorted.begin(), sorted.begin() + corners / 2, sorted.begin() + corners);
+  const float median = sorted[corners / 2];
+  const auto outlier = [&](int k) {
+    return std::abs(luminance[k] - median) > kRefinedKdOutlier * median + 0.01f;
+  };
+  int outliers = 0;
+  for (int k = 0; k < corners; ++k) outliers += outlier(k);
+  const bool leave_out = corners >= 4 && 4 * outliers <= corners;
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  float weights = 0;
+  for (int k = 0; k < corners; ++k) {
+    if (leave_out && outlier(k)) continue;
+    sum += weight[k] * albedo[k];
+    weights += weight[k];
   }
   if (!(weights > 1e-6f)) return false;
   kd = sum / weights;

@@ -25,25 +25,66 @@ TEST(MaterialMaps, ShadingIsEquationSixSummedOverTheLights) {
   EXPECT_TRUE(shade_ward(m, p, n, eye, lights).isApprox(expected, 1e-6f));
 }
 
-TEST(MaterialMaps, RefinedAlbedoInterpolatesWithinTheSegmentOnly) {
-  // 4-pixel TSDF allocation stride = 3.3 cm < one 4 cm block at 1 m: no block rows missing.
-  const Intrinsics camera{80, 60, 120.0, 120.0, 39.5, 29.5};
-  fusion::VolumeParams volume;
-  volume.block_capacity = 1 << 12;
-  fusion::TsdfVolume geometry(volume);
-  fusion::VisibleBlocks blocks;
-  // A wall at z = 1.005 m, inside one layer of 2 cm voxels (not on a voxel face).
-  const ImageF depth(80, 60, 1, 1.005f), colour(80, 60, 3, 0.2f);
-  fusion::integrate(geometry, depth, colour, camera, Pose::Identity(), blocks);
-  ObservationGrid grid(ObservationGridParams{.voxel_capacity = 1 << 14});
-  const auto& visible = grid.collect(depth, colour, camera, Pose::Identity(), 1.0f, geometry, 0);
-  ASSERT_GT(visible.size(), 20u);
-  for (const VisibleVoxel& seen : visible) {
-    grid.segment(seen.voxel) = 3;
-    grid.has_refined_kd(seen.voxel) = true;
-    // A ramp in x: linear, so trilinear interpolation reproduces it between voxel centres.
-    grid.refined_kd(seen.voxel) = Eigen::Vector3f::Constant(0.5f + grid.position(seen.voxel).x());
+// Observation voxels (2 cm) of a wall at z = 1.005 m, inside one layer of them (not on a voxel
+// face), all in segment 3 with a refined albedo set by `albedo_at` of their surface point.
+class Wall {
+ public:
+  Wall() : geometry_(volume_params()), grid_(ObservationGridParams{.voxel_capacity = 1 << 14}) {
+    // 4-pixel TSDF allocation stride = 3.3 cm < one 4 cm block at 1 m: no block rows missing.
+    const Intrinsics camera{80, 60, 120.0, 120.0, 39.5, 29.5};
+    fusion::VisibleBlocks blocks;
+    const ImageF depth(80, 60, 1, 1.005f), colour(80, 60, 3, 0.2f);
+    fusion::integrate(geometry_, depth, colour, camera, Pose::Identity(), blocks);
+    visible_ = grid_.collect(depth, colour, camera, Pose::Identity(), 1.0f, geometry_, 0);
   }
+  template <class AlbedoAt>
+  ObservationGrid& with_albedo(AlbedoAt albedo_at) {
+    for (const VisibleVoxel& seen : visible_) {
+      grid_.segment(seen.voxel) = 3;
+      grid_.has_refined_kd(seen.voxel) = true;
+      grid_.refined_kd(seen.voxel) = albedo_at(grid_.position(seen.voxel));
+    }
+    return grid_;
+  }
+  std::size_t voxels() const { return visible_.size(); }
+
+ private:
+  static fusion::VolumeParams volume_params() {
+    fusion::VolumeParams volume;
+    volume.block_capacity = 1 << 12;
+    return volume;
+  }
+  fusion::TsdfVolume geometry_;
+  ObservationGrid grid_;
+  std::vector<VisibleVoxel> visible_;
+};
+
+TEST(MaterialMaps, ACornerWhoseAlbedoIsAnOutlierIsLeftOutButATextureEdgeIsNot) {
+  Wall wall;
+  ASSERT_GT(wall.voxels(), 20u);
+  const Eigen::Vector3f p(0.013f, -0.007f, 1.005f);
+  // A crease voxel gone white (eq. 7 with too little irradiance) beside p on a 0.4 wall.
+  ObservationGrid& grid = wall.with_albedo([&](const Eigen::Vector3f& q) {
+    return Eigen::Vector3f::Constant((q - p).head<2>().norm() < 0.012f ? 1.0f : 0.4f);
+  });
+  Eigen::Vector3f kd;
+  ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, kd));
+  EXPECT_NEAR(kd.x(), 0.4f, 1e-6f);
+  // A texture edge through the cell: half the corners 0.3, half 0.9; both are kept.
+  wall.with_albedo([&](const Eigen::Vector3f& q) {
+    return Eigen::Vector3f::Constant(q.x() < p.x() ? 0.3f : 0.9f);
+  });
+  ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, kd));
+  EXPECT_GT(kd.x(), 0.35f);
+  EXPECT_LT(kd.x(), 0.85f);
+}
+
+TEST(MaterialMaps, RefinedAlbedoInterpolatesWithinTheSegmentOnly) {
+  Wall wall;
+  ASSERT_GT(wall.voxels(), 20u);
+  // A ramp in x: linear, so trilinear interpolation reproduces it between voxel centres.
+  ObservationGrid& grid = wall.with_albedo(
+      [](const Eigen::Vector3f& q) { return Eigen::Vector3f::Constant(0.5f + q.x()); });
   // Centre of the wall, between voxel centres.
   const Eigen::Vector3f p(0.013f, -0.007f, 1.005f);
   Eigen::Vector3f kd;
