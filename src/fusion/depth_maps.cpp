@@ -12,6 +12,11 @@ namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
+// The three channels of a point or normal map at (x, y).
+Eigen::Vector3f vector_at(const ImageF& image, int x, int y) {
+  return {image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2)};
+}
+
 }  // namespace
 
 ImageF bilateral_filter_depth(const ImageF& depth_m, const BilateralParams& params) {
@@ -104,9 +109,7 @@ ImageF points_from_depth(const ImageF& depth_m, const Intrinsics& intrinsics) {
 ImageF normals_from_points(const ImageF& points, const Eigen::Vector3d& viewpoint) {
   const int width = points.width(), height = points.height();
   ImageF normals(width, height, 3, kNaN);
-  const auto point = [&](int x, int y) {
-    return Eigen::Vector3f(points.at(x, y, 0), points.at(x, y, 1), points.at(x, y, 2));
-  };
+  const auto point = [&](int x, int y) { return vector_at(points, x, y); };
   const Eigen::Vector3f eye = viewpoint.cast<float>();
   parallel_for(static_cast<std::size_t>(height), [&](std::size_t row) {
     const int y = static_cast<int>(row);
@@ -127,27 +130,24 @@ ImageF smooth_normals(const ImageF& points, const ImageF& normals, const ImageF&
                       const Intrinsics& intrinsics, float radius_m) {
   const int width = points.width(), height = points.height();
   ImageF smoothed(width, height, 3, kNaN);
-  const auto vector = [](const ImageF& image, int x, int y) {
-    return Eigen::Vector3f(image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2));
-  };
   constexpr int kMaxRadiusPx = 8;
   constexpr float kSameFace = 0.5f;  // cos 60 degrees
   const float radius_squared = radius_m * radius_m;
   parallel_for(static_cast<std::size_t>(height), [&](std::size_t row) {
     const int y = static_cast<int>(row);
     for (int x = 0; x < width; ++x) {
-      const Eigen::Vector3f n = vector(normals, x, y);
+      const Eigen::Vector3f n = vector_at(normals, x, y);
       const float depth = depth_m.at(x, y, 0);
       if (!n.allFinite() || !(depth > 0)) continue;
-      const Eigen::Vector3f p = vector(points, x, y);
+      const Eigen::Vector3f p = vector_at(points, x, y);
       const int window = std::min(
           kMaxRadiusPx, static_cast<int>(std::ceil(radius_m * float(intrinsics.fx) / depth)));
       Eigen::Vector3f sum = Eigen::Vector3f::Zero();
       for (int v = std::max(0, y - window); v <= std::min(height - 1, y + window); ++v)
         for (int u = std::max(0, x - window); u <= std::min(width - 1, x + window); ++u) {
-          const Eigen::Vector3f m = vector(normals, u, v);
+          const Eigen::Vector3f m = vector_at(normals, u, v);
           if (!m.allFinite() || m.dot(n) < kSameFace) continue;
-          if ((vector(points, u, v) - p).squaredNorm() > radius_squared) continue;
+          if ((vector_at(points, u, v) - p).squaredNorm() > radius_squared) continue;
           sum += m;
         }
       const Eigen::Vector3f mean = sum.normalized();

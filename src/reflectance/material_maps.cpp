@@ -52,19 +52,21 @@ bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& 
   // irradiance, and its eq. (7) albedo comes out near 0 or 1. Among four or more corners, a
   // minority (at most a quarter) whose mean albedo is more than half off the corners' median is
   // left out; a texture edge through the cell splits the corners more evenly and stays.
+  // (The 0.01 keeps near-black corners from all being outliers of one another.)
   std::array<float, 8> sorted = luminance;
   std::nth_element(sorted.begin(), sorted.begin() + corners / 2, sorted.begin() + corners);
   const float median = sorted[corners / 2];
-  const auto outlier = [&](int k) {
-    return std::abs(luminance[k] - median) > kRefinedKdOutlier * median + 0.01f;
-  };
+  std::array<bool, 8> outlier;
   int outliers = 0;
-  for (int k = 0; k < corners; ++k) outliers += outlier(k);
+  for (int k = 0; k < corners; ++k) {
+    outlier[k] = std::abs(luminance[k] - median) > kRefinedKdOutlier * median + 0.01f;
+    outliers += outlier[k];
+  }
   const bool leave_out = corners >= 4 && 4 * outliers <= corners;
   Eigen::Vector3f sum = Eigen::Vector3f::Zero();
   float weights = 0;
   for (int k = 0; k < corners; ++k) {
-    if (leave_out && outlier(k)) continue;
+    if (leave_out && outlier[k]) continue;
     sum += weight[k] * albedo[k];
     weights += weight[k];
   }
