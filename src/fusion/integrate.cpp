@@ -16,24 +16,6 @@
 namespace glint::fusion {
 namespace {
 
-// Neighbouring pixels mostly hit the same blocks: a small direct-mapped cache of the blocks a
-// chunk of rows already handled skips most repeated hash insertions.
-class RecentBlocks {
- public:
-  RecentBlocks() { keys_.fill(~std::uint64_t{0}); }
-  // True when the block was seen recently; remembers it otherwise.
-  bool seen(int x, int y, int z) {
-    const std::uint64_t key = pack_block_key(x, y, z);
-    std::uint64_t& slot = keys_[teschner_hash(x, y, z) & (keys_.size() - 1)];
-    if (slot == key) return true;
-    slot = key;
-    return false;
-  }
-
- private:
-  std::array<std::uint64_t, 256> keys_;
-};
-
 void require_same_size(const ImageF& depth_m, const ImageF& colour, const Intrinsics& k) {
   if (depth_m.channels() != 1 || depth_m.width() != k.width || depth_m.height() != k.height)
     throw Error("depth image", "",
@@ -62,10 +44,10 @@ void allocate_blocks(TsdfVolume& volume, const ImageF& depth_m, const Intrinsics
   std::atomic<bool> pool_full{false};
   tbb::enumerable_thread_specific<std::vector<int>> found;
 
+  tbb::enumerable_thread_specific<std::vector<Eigen::Vector3i>> buffers;
   const std::size_t rows = (depth_m.height() + stride - 1) / stride;
   parallel_for_chunks(rows, 4, [&](std::size_t row_begin, std::size_t row_end) {
-    RecentBlocks recent;
-    std::vector<int>& local = found.local();
+    PendingBlocks pending(volume.hash(), buffers.local());
     for (std::size_t y = row_begin * stride; y < row_end * stride && y < height; y += stride) {
       for (int x = 0; x < width; x += stride) {
         const float d = depth[y * width + x];
@@ -75,16 +57,18 @@ void allocate_blocks(TsdfVolume& volume, const ImageF& depth_m, const Intrinsics
             rotation * intrinsics.ray(x, static_cast<double>(y)).cast<float>();
         const Eigen::Vector3f near = origin + ray * (d - truncation);
         const Eigen::Vector3f far = origin + ray * (d + truncation);
-        for_each_cell_on_segment(near.data(), far.data(), block_size, [&](int bx, int by, int bz) {
-          if (recent.seen(bx, by, bz)) return;
-          const int index = volume.allocate({bx, by, bz});
-          if (index < 0) {
-            pool_full.store(true, std::memory_order_relaxed);
-            return;
-          }
-          if (volume.mark_visible(index, frame)) local.push_back(index);
-        });
+        for_each_cell_on_segment(near.data(), far.data(), block_size,
+                                 [&](int bx, int by, int bz) { pending.add(bx, by, bz); });
       }
+    }
+    std::vector<int>& local = found.local();
+    for (const Eigen::Vector3i& block : pending.blocks()) {
+      const int index = volume.allocate(block);
+      if (index < 0) {
+        pool_full.store(true, std::memory_order_relaxed);
+        return;
+      }
+      if (volume.mark_visible(index, frame)) local.push_back(index);
     }
   });
 

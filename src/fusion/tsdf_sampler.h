@@ -1,8 +1,9 @@
 #pragma once
 // TsdfSampler: reads the TSDF at arbitrary world points (nearest voxel or trilinear), caching
-// the last block looked up (rays and neighbouring samples mostly stay in one block). One sampler
-// per thread; the volume must not change while it is read.
+// the blocks last looked up (rays and neighbouring samples mostly stay in a few blocks). One
+// sampler per thread; the volume must not change while it is read.
 #include <Eigen/Core>
+#include <array>
 #include <cmath>
 
 #include "fusion/tsdf_volume.h"
@@ -76,21 +77,17 @@ class TsdfSampler {
     const int x = round_to_int(v.x()), y = round_to_int(v.y()), z = round_to_int(v.z());
     if (voxel(x, y, z, unused) != Sample::observed) return Eigen::Vector3f::Zero();
     const int index = voxel_in_block(x, y, z);
-    return {volume_.red(block_)[index], volume_.green(block_)[index], volume_.blue(block_)[index]};
+    const int block = cached_block(x >> 3, y >> 3, z >> 3);
+    return {volume_.red(block)[index], volume_.green(block)[index], volume_.blue(block)[index]};
   }
 
   // Global voxel coordinates -> its sample.
   Sample voxel(int x, int y, int z, float& sdf_m) {
-    const Eigen::Vector3i block(x >> 3, y >> 3, z >> 3);  // floor division by 8
-    if (block != cached_coordinates_ || !cached_) {
-      cached_coordinates_ = block;
-      cached_ = true;
-      block_ = volume_.hash().find(block);
-    }
-    if (block_ < 0) return Sample::unallocated;
+    const int block = cached_block(x >> 3, y >> 3, z >> 3);  // floor division by 8
+    if (block < 0) return Sample::unallocated;
     const int index = voxel_in_block(x, y, z);
-    if (volume_.weight(block_)[index] <= 0) return Sample::unobserved;
-    sdf_m = volume_.sdf_m(block_)[index];
+    if (volume_.weight(block)[index] <= 0) return Sample::unobserved;
+    sdf_m = volume_.sdf_m(block)[index];
     return Sample::observed;
   }
 
@@ -103,11 +100,25 @@ class TsdfSampler {
   }
   static int round_to_int(float value) { return static_cast<int>(std::floor(value + 0.5f)); }
 
+  // The pool index of block (bx, by, bz), or -1. A stencil of a few voxels spans at most two
+  // blocks along each axis, which differ in the parity of that coordinate: one cache entry per
+  // parity triple holds all eight, where a single entry was looked up again at every crossing.
+  int cached_block(int bx, int by, int bz) {
+    const int entry = (bx & 1) | ((by & 1) << 1) | ((bz & 1) << 2);
+    const Eigen::Vector3i block(bx, by, bz);
+    if (!(cached_ >> entry & 1) || cached_coordinates_[entry] != block) {
+      cached_coordinates_[entry] = block;
+      cached_ |= 1u << entry;
+      block_[entry] = volume_.hash().find(block);
+    }
+    return block_[entry];
+  }
+
   const TsdfVolume& volume_;
   float inverse_voxel_;
-  Eigen::Vector3i cached_coordinates_ = Eigen::Vector3i::Zero();
-  bool cached_ = false;
-  int block_ = -1;
+  std::array<Eigen::Vector3i, 8> cached_coordinates_;
+  std::array<int, 8> block_;
+  unsigned cached_ = 0;  // bit e: entry e holds a block
 };
 
 }  // namespace glint::fusion

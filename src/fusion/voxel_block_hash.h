@@ -9,6 +9,7 @@
 // concurrently with other find() calls but not with insert(). Block coordinates must lie in
 // [-2^20, 2^20) on each axis (+-5 km at 5 mm voxels).
 #include <Eigen/Core>
+#include <array>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -47,6 +48,12 @@ class VoxelBlockHash {
   Insertion insert(const Eigen::Vector3i& block);
   // The block's pool index or kAbsent.
   int find(const Eigen::Vector3i& block) const;
+  // Asks for the cache line of the block's first probe slot ahead of an insert() or find(): the
+  // table is far larger than the caches, so nearly every first probe misses.
+  void prefetch(const Eigen::Vector3i& block) const {
+    __builtin_prefetch(
+        &slots_table_[teschner_hash(block.x(), block.y(), block.z()) & (slots_ - 1)]);
+  }
 
   std::size_t size() const;  // blocks in the pool
   std::size_t capacity() const { return capacity_; }
@@ -69,6 +76,34 @@ class VoxelBlockHash {
   PoolArray<Slot> slots_table_;
   std::vector<Eigen::Vector3i> blocks_;
   std::atomic<std::size_t> used_{0};
+};
+
+// The blocks a chunk of image rows touches, gathered before any is inserted into `hash`:
+// neighbouring pixels mostly hit the same blocks, so a small direct-mapped cache of the blocks
+// already gathered skips most repeats, and each new block's hash slot is prefetched when it is
+// gathered, so the cache misses of the inserts that follow overlap instead of stalling one
+// after another. `blocks` is the caller's (per-thread) buffer, cleared here.
+class PendingBlocks {
+ public:
+  PendingBlocks(const VoxelBlockHash& hash, std::vector<Eigen::Vector3i>& blocks)
+      : hash_(hash), blocks_(blocks) {
+    recent_.fill(~std::uint64_t{0});
+    blocks_.clear();
+  }
+  void add(int x, int y, int z) {
+    std::uint64_t& slot = recent_[teschner_hash(x, y, z) & (recent_.size() - 1)];
+    const std::uint64_t key = pack_block_key(x, y, z);
+    if (slot == key) return;
+    slot = key;
+    blocks_.emplace_back(x, y, z);
+    hash_.prefetch(blocks_.back());
+  }
+  const std::vector<Eigen::Vector3i>& blocks() const { return blocks_; }
+
+ private:
+  const VoxelBlockHash& hash_;
+  std::vector<Eigen::Vector3i>& blocks_;
+  std::array<std::uint64_t, 256> recent_;
 };
 
 }  // namespace glint::fusion

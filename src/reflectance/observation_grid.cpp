@@ -160,17 +160,22 @@ void ObservationGrid::allocate(const ImageF& depth_m, const Intrinsics& intrinsi
   const int rows = (depth_m.height() + stride - 1) / stride;
   frame_blocks_.clear();
   tbb::enumerable_thread_specific<std::vector<int>> local_blocks;
-  parallel_for(std::size_t(rows), [&](std::size_t row) {
-    const int y = int(row) * stride;
+  tbb::enumerable_thread_specific<std::vector<Eigen::Vector3i>> buffers;
+  parallel_for_chunks(std::size_t(rows), 4, [&](std::size_t row_begin, std::size_t row_end) {
+    fusion::PendingBlocks pending(hash_, buffers.local());
+    for (std::size_t row = row_begin; row < row_end; ++row) {
+      const int y = int(row) * stride;
+      for (int x = 0; x < depth_m.width(); x += stride) {
+        const float z = depth_m.at(x, y, 0);
+        if (!(z > 0) || !std::isfinite(z)) continue;
+        const Eigen::Vector3f p =
+            rotation * intrinsics.back_project(x, y, z).cast<float>() + translation;
+        const Eigen::Vector3f b = p * inverse_block;
+        pending.add(int(std::floor(b.x())), int(std::floor(b.y())), int(std::floor(b.z())));
+      }
+    }
     std::vector<int>& mine = local_blocks.local();
-    for (int x = 0; x < depth_m.width(); x += stride) {
-      const float z = depth_m.at(x, y, 0);
-      if (!(z > 0) || !std::isfinite(z)) continue;
-      const Eigen::Vector3f p =
-          rotation * intrinsics.back_project(x, y, z).cast<float>() + translation;
-      const Eigen::Vector3f b = p * inverse_block;
-      const Eigen::Vector3i block(int(std::floor(b.x())), int(std::floor(b.y())),
-                                  int(std::floor(b.z())));
+    for (const Eigen::Vector3i& block : pending.blocks()) {
       const auto insertion = hash_.insert(block);
       if (insertion.index < 0) {
         pool_full = true;
@@ -240,12 +245,16 @@ void ObservationGrid::fit_normals_to_neighbours(std::size_t slot, int frame) {
   while (first < voxels_per_block_ && !refreshed(first_voxel + first)) ++first;
   if (first == voxels_per_block_) return;  // the 27 block look-ups would serve no voxel
 
-  // The 3^3 blocks around this one, looked up once for all of its voxels.
+  // The 3^3 blocks around this one, looked up once for all of its voxels (their hash slots
+  // prefetched first, so that the misses overlap).
   const Eigen::Vector3i block_coordinates = hash_.block(block);
+  const auto neighbour = [&](int i) {
+    return Eigen::Vector3i(block_coordinates +
+                           Eigen::Vector3i(i % 3 - 1, (i / 3) % 3 - 1, i / 9 - 1));
+  };
+  for (int i = 0; i < 27; ++i) hash_.prefetch(neighbour(i));
   std::array<int, 27> around;
-  for (int i = 0; i < 27; ++i)
-    around[i] =
-        hash_.find(block_coordinates + Eigen::Vector3i(i % 3 - 1, (i / 3) % 3 - 1, i / 9 - 1));
+  for (int i = 0; i < 27; ++i) around[i] = hash_.find(neighbour(i));
   const Eigen::Vector3i origin = (block_coordinates - Eigen::Vector3i::Ones()) * side_;
   // Neighbours more than 30 degrees off the voxel's tangent plane belong to another face.
   const float max_off_plane = std::sin(float(M_PI) / 6);

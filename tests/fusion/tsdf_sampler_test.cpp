@@ -72,5 +72,17 @@ TEST(TsdfSampler, AnUnobservedFaceNeighbourFailsTheGradientOnly) {
   EXPECT_FALSE(sampler.trilinear_with_gradient(p, value, gradient));
 }
 
+TEST(TsdfSampler, ABlockOfTheSameParityIsLookedUpAfresh) {
+  // Blocks 0 and 2 along x share a cache entry; only block 0 is allocated.
+  TsdfVolume volume(centimetre_voxels());
+  ASSERT_GE(volume.allocate({0, 0, 0}), 0);
+  std::fill_n(volume.weight(volume.hash().find({0, 0, 0})), kVoxelsPerBlock, 1.0f);
+  TsdfSampler sampler(volume);
+  float sdf = 0;
+  EXPECT_EQ(sampler.voxel(3, 3, 3, sdf), TsdfSampler::Sample::observed);
+  EXPECT_EQ(sampler.voxel(19, 3, 3, sdf), TsdfSampler::Sample::unallocated);
+  EXPECT_EQ(sampler.voxel(3, 3, 3, sdf), TsdfSampler::Sample::observed);
+}
+
 }  // namespace
 }  // namespace glint::fusion

@@ -28,6 +28,17 @@ TEST(VoxelBlockHash, InsertThenFindAndReinsertKeepsTheIndex) {
   EXPECT_EQ(hash.block(b.index), Eigen::Vector3i(-1000, 5, 0));
 }
 
+TEST(PendingBlocks, SkipsRepeatsOfRecentBlocksAndKeepsTheirOrder) {
+  const VoxelBlockHash hash(100);
+  std::vector<Eigen::Vector3i> buffer{{9, 9, 9}};  // a previous chunk's: cleared
+  PendingBlocks pending(hash, buffer);
+  for (const Eigen::Vector3i& block : {Eigen::Vector3i(1, 2, 3), Eigen::Vector3i(1, 2, 3),
+                                       Eigen::Vector3i(-4, 0, 7), Eigen::Vector3i(1, 2, 3)})
+    pending.add(block.x(), block.y(), block.z());
+  EXPECT_EQ(pending.blocks(), (std::vector<Eigen::Vector3i>{{1, 2, 3}, {-4, 0, 7}}));
+  EXPECT_EQ(hash.size(), 0u);  // gathering inserts nothing
+}
+
 TEST(VoxelBlockHash, CollidingKeysAreAllFound) {
   VoxelBlockHash hash(64);
   const std::uint32_t mask = static_cast<std::uint32_t>(hash.slot_count() - 1);
