@@ -95,6 +95,26 @@ void ObservationGrid::prefetch_voxel_state(int block) const {
   prefetch_lines(observation_set_.get() + first, voxels * sizeof(std::int32_t));
 }
 
+Eigen::Vector3i ObservationGrid::geometry_block(const fusion::TsdfVolume& geometry,
+                                                int block) const {
+  const Eigen::Vector3f centre =
+      (hash_.block(block).cast<float>() + Eigen::Vector3f::Constant(0.5f)) *
+      float(params_.block_size_m / geometry.params().block_size_m());
+  return {int(std::floor(centre.x())), int(std::floor(centre.y())), int(std::floor(centre.z()))};
+}
+
+void ObservationGrid::prefetch_geometry_if_due(const fusion::TsdfVolume& geometry, int block,
+                                               int frame) const {
+  const int* next_refresh = next_refresh_frame_.get() + std::size_t(block) * voxels_per_block_;
+  if (std::none_of(next_refresh, next_refresh + voxels_per_block_,
+                   [&](int due) { return frame >= due; }))
+    return;
+  const int index = geometry.hash().find(geometry_block(geometry, block));
+  if (index < 0) return;
+  prefetch_lines(geometry.sdf_m(index), fusion::kVoxelsPerBlock * sizeof(float));
+  prefetch_lines(geometry.weight(index), fusion::kVoxelsPerBlock * sizeof(float));
+}
+
 ObservationGrid::ObservationGrid(const ObservationGridParams& params)
     : params_(params),
       side_(block_side(params)),
@@ -315,7 +335,10 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
   const std::size_t blocks = frame_blocks_.size();
   parallel_for(blocks, [&](std::size_t slot) {
     const int block = frame_blocks_[slot];
-    prefetch_voxel_state(frame_blocks_[slot + 1 < blocks ? slot + 1 : slot]);
+    const int next_block = frame_blocks_[slot + 1 < blocks ? slot + 1 : slot];
+    prefetch_voxel_state(next_block);
+    geometry.hash().prefetch(geometry_block(geometry, next_block));
+    prefetch_geometry_if_due(geometry, block, frame);
     fusion::TsdfSampler sampler(geometry);  // its block cache serves the block's voxels
     const Eigen::Vector3i first_voxel = hash_.block(block) * side_;
     std::array<Seen, kChunk> seen;
