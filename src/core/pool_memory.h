@@ -20,6 +20,15 @@ struct PoolDeleter {
 template <class T>
 using PoolArray = std::unique_ptr<T[], PoolDeleter>;
 
+// Asks for the cache lines of [p, p + bytes) ahead of use: a frame's blocks lie scattered in the
+// pools, so the hardware prefetcher cannot guess them.
+inline void prefetch_lines(const void* p, std::size_t bytes) {
+  constexpr std::size_t kLine = 64;
+  const auto* first = static_cast<const char*>(p);
+  for (std::size_t offset = 0; offset < bytes; offset += kLine) __builtin_prefetch(first + offset);
+  if (bytes > 0) __builtin_prefetch(first + bytes - 1);
+}
+
 namespace detail {
 // Maps zero-filled memory for `count` elements of `element_bytes` (pages committed on first
 // touch) and returns the array's start; `deleter` learns what to unmap. Throws glint::Error

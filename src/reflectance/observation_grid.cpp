@@ -22,14 +22,6 @@ PoolArray<T> voxel_pool(std::size_t count) {
   return make_pool<T>(count, "observation grid");
 }
 
-// Asks for the cache lines of [p, p + bytes) ahead of use.
-void prefetch_lines(const void* p, std::size_t bytes) {
-  constexpr std::size_t kLine = 64;
-  const auto* first = static_cast<const char*>(p);
-  for (std::size_t offset = 0; offset < bytes; offset += kLine) __builtin_prefetch(first + offset);
-  if (bytes > 0) __builtin_prefetch(first + bytes - 1);
-}
-
 // The normal of the least-squares plane through `count` points, on `reference`'s side; nullopt for
 // fewer than five points or points along a line (a thin strip of surface fixes no plane).
 std::optional<Eigen::Vector3f> fit_plane(const Eigen::Vector3f* points, int count,
@@ -95,24 +87,21 @@ void ObservationGrid::prefetch_voxel_state(int block) const {
   prefetch_lines(observation_set_.get() + first, voxels * sizeof(std::int32_t));
 }
 
-Eigen::Vector3i ObservationGrid::geometry_block(const fusion::TsdfVolume& geometry,
-                                                int block) const {
+Eigen::Vector3i ObservationGrid::geometry_block(int block, float geometry_blocks_per_block) const {
   const Eigen::Vector3f centre =
       (hash_.block(block).cast<float>() + Eigen::Vector3f::Constant(0.5f)) *
-      float(params_.block_size_m / geometry.params().block_size_m());
+      geometry_blocks_per_block;
   return {int(std::floor(centre.x())), int(std::floor(centre.y())), int(std::floor(centre.z()))};
 }
 
 void ObservationGrid::prefetch_geometry_if_due(const fusion::TsdfVolume& geometry, int block,
-                                               int frame) const {
+                                               int frame, float geometry_blocks_per_block) const {
   const int* next_refresh = next_refresh_frame_.get() + std::size_t(block) * voxels_per_block_;
   if (std::none_of(next_refresh, next_refresh + voxels_per_block_,
                    [&](int due) { return frame >= due; }))
     return;
-  const int index = geometry.hash().find(geometry_block(geometry, block));
-  if (index < 0) return;
-  prefetch_lines(geometry.sdf_m(index), fusion::kVoxelsPerBlock * sizeof(float));
-  prefetch_lines(geometry.weight(index), fusion::kVoxelsPerBlock * sizeof(float));
+  const int index = geometry.hash().find(geometry_block(block, geometry_blocks_per_block));
+  if (index >= 0) geometry.prefetch_block(index);
 }
 
 ObservationGrid::ObservationGrid(const ObservationGridParams& params)
@@ -268,9 +257,8 @@ void ObservationGrid::fit_normals_to_neighbours(std::size_t slot, int frame) {
   // The 3^3 blocks around this one, looked up once for all of its voxels (their hash slots
   // prefetched first, so that the misses overlap).
   const Eigen::Vector3i block_coordinates = hash_.block(block);
-  const auto neighbour = [&](int i) {
-    return Eigen::Vector3i(block_coordinates +
-                           Eigen::Vector3i(i % 3 - 1, (i / 3) % 3 - 1, i / 9 - 1));
+  const auto neighbour = [&](int i) -> Eigen::Vector3i {
+    return block_coordinates + Eigen::Vector3i(i % 3 - 1, (i / 3) % 3 - 1, i / 9 - 1);
   };
   for (int i = 0; i < 27; ++i) hash_.prefetch(neighbour(i));
   std::array<int, 27> around;
@@ -333,12 +321,14 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
   };
   constexpr int kChunk = 64;
   const std::size_t blocks = frame_blocks_.size();
+  const float geometry_blocks_per_block =
+      float(params_.block_size_m / geometry.params().block_size_m());
   parallel_for(blocks, [&](std::size_t slot) {
     const int block = frame_blocks_[slot];
     const int next_block = frame_blocks_[slot + 1 < blocks ? slot + 1 : slot];
     prefetch_voxel_state(next_block);
-    geometry.hash().prefetch(geometry_block(geometry, next_block));
-    prefetch_geometry_if_due(geometry, block, frame);
+    geometry.hash().prefetch(geometry_block(next_block, geometry_blocks_per_block));
+    prefetch_geometry_if_due(geometry, block, frame, geometry_blocks_per_block);
     fusion::TsdfSampler sampler(geometry);  // its block cache serves the block's voxels
     const Eigen::Vector3i first_voxel = hash_.block(block) * side_;
     std::array<Seen, kChunk> seen;

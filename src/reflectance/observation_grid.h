@@ -148,12 +148,13 @@ class ObservationGrid {
   void fit_normals_to_neighbours(std::size_t slot, int frame);
   // Prefetches the per-voxel state collect() reads first for the voxels of `block`.
   void prefetch_voxel_state(int block) const;
-  // The geometry (TSDF) block that holds the centre of observation block `block`.
-  Eigen::Vector3i geometry_block(const fusion::TsdfVolume& geometry, int block) const;
-  // When a voxel of `block` is due for a surface refresh in `frame`, prefetches the distances and
-  // weights of the geometry block its stencils mostly read (4 KB at 5 mm voxels): read voxel by
-  // voxel, each of their cache misses stalled the next.
-  void prefetch_geometry_if_due(const fusion::TsdfVolume& geometry, int block, int frame) const;
+  // The geometry (TSDF) block that holds the centre of observation block `block`, given the
+  // ratio of the two block sizes.
+  Eigen::Vector3i geometry_block(int block, float geometry_blocks_per_block) const;
+  // When a voxel of `block` is due for a surface refresh in `frame`, prefetches the geometry
+  // block its stencils mostly read: read voxel by voxel, each cache miss stalled the next.
+  void prefetch_geometry_if_due(const fusion::TsdfVolume& geometry, int block, int frame,
+                                float geometry_blocks_per_block) const;
 
   ObservationGridParams params_;
   int side_ = 2;
