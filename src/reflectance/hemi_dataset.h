@@ -26,7 +26,6 @@ namespace glint::reflectance {
 
 inline constexpr int kMinHemiImages = 25;   // one set of the HemiCNN's input
 inline constexpr int kMaxHemiImages = 500;  // the paper's hemi-images per sequence
-inline constexpr int kMinHemiImageSize = 3, kMaxHemiImageSize = 64;
 
 // "parabolic" / "orthographic" and back; an unknown name -> glint::Error(where, "projection").
 const char* hemi_projection_name(HemiProjection projection);

@@ -4,6 +4,10 @@
 #include <cmath>
 #include <limits>
 
+#include <fmt/format.h>
+
+#include "core/error.h"
+
 namespace glint::reflectance {
 
 Eigen::Matrix3f local_frame(const Eigen::Vector3f& n) {
@@ -31,6 +35,10 @@ void make_hemi_image(const Observation* observations, int count, const Eigen::Ve
                      const HemiImageParams& params, float* out) {
   const int size = params.size;
   const int pixels = size * size;
+  if (size < kMinHemiImageSize || size > kMaxHemiImageSize)
+    throw Error("hemi-image", "size",
+                fmt::format("{} pixels per side is outside [{}, {}]", size, kMinHemiImageSize,
+                            kMaxHemiImageSize));
   constexpr int kMaxObservations = 256;
   std::array<Eigen::Vector2f, kMaxObservations> position;
   std::array<int, kMaxObservations> source;
@@ -43,19 +51,31 @@ void make_hemi_image(const Observation* observations, int count, const Eigen::Ve
     position[kept] = (project_to_disk(local, params.projection).array() + 1.0f) * half_extent;
     source[kept++] = k;
   }
-  for (int y = 0; y < size; ++y)
-    for (int x = 0; x < size; ++x) {
-      Eigen::Vector3f colour = Eigen::Vector3f::Zero();
-      float nearest = std::numeric_limits<float>::max();
-      for (int k = 0; k < kept; ++k) {
-        const float distance = (position[k] - Eigen::Vector2f(float(x), float(y))).squaredNorm();
-        if (distance < nearest) {
-          nearest = distance;
-          colour = observations[source[k]].colour;
-        }
+  // Nearest observation of every pixel, a row at a time: the loop over a row's pixels has no
+  // branches and vectorises (ties go to the first observation, as in a plain scan).
+  std::array<float, kMaxHemiImageSize> nearest, column;
+  std::array<int, kMaxHemiImageSize> index;
+  for (int x = 0; x < size; ++x) column[x] = float(x);
+  for (int y = 0; y < size; ++y) {
+    nearest.fill(std::numeric_limits<float>::max());
+    index.fill(-1);
+    for (int k = 0; k < kept; ++k) {
+      const float px = position[k].x(), dy = position[k].y() - float(y);
+      const float dy2 = dy * dy;
+      for (int x = 0; x < size; ++x) {
+        const float dx = px - column[x];
+        const float distance = dx * dx + dy2;
+        const bool closer = distance < nearest[x];
+        nearest[x] = closer ? distance : nearest[x];
+        index[x] = closer ? k : index[x];
       }
+    }
+    for (int x = 0; x < size; ++x) {
+      const Eigen::Vector3f colour =
+          index[x] < 0 ? Eigen::Vector3f::Zero() : observations[source[index[x]]].colour;
       for (int c = 0; c < 3; ++c) out[c * pixels + y * size + x] = colour[c];
     }
+  }
 }
 
 }  // namespace glint::reflectance

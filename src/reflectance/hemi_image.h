@@ -13,8 +13,11 @@ namespace glint::reflectance {
 
 enum class HemiProjection { parabolic, orthographic };
 
+// Hemi-image sizes glint supports (pixels per side).
+inline constexpr int kMinHemiImageSize = 3, kMaxHemiImageSize = 64;
+
 struct HemiImageParams {
-  int size = 15;  // pixels per side
+  int size = 15;  // pixels per side, in [kMinHemiImageSize, kMaxHemiImageSize]
   HemiProjection projection = HemiProjection::parabolic;
 };
 
