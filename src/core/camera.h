@@ -8,8 +8,11 @@
 namespace glint {
 
 // Axial depth noise of a Kinect-like time-of-flight sensor at depth z (metres): sigma(z) =
-// 0.0012 + 0.0019 (z - 0.4)^2 (Nguyen, Izadi and Lovell 2012).
-inline float kinect_axial_noise_m(float z) { return 0.0012f + 0.0019f * (z - 0.4f) * (z - 0.4f); }
+// 0.0012 + 0.0019 (z - 0.4)^2 (Nguyen, Izadi and Lovell 2012). Float, or a vector of floats.
+template <class Float>
+inline Float kinect_axial_noise_m(Float z) {
+  return 0.0012f + 0.0019f * (z - 0.4f) * (z - 0.4f);
+}
 
 // Rigid transform; by convention a camera pose maps camera coordinates to world coordinates
 // (camera-to-world), as in TUM groundtruth.txt and 7-Scenes pose.txt files.

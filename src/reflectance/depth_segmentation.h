@@ -10,6 +10,7 @@
 // Non-edge pixels form 4-connected components; small ones are dropped; edge pixels then take
 // the label of the nearest labelled pixel within a small window.
 #include <cstdint>
+#include <vector>
 
 #include "core/camera.h"
 #include "core/image.h"
@@ -33,7 +34,42 @@ struct DepthSegmentation {
   Image<std::uint8_t> edges;   // 1 where a concave boundary or discontinuity was detected
 };
 
-// depth: 1 channel, metres along the optical axis, 0 or non-finite = no measurement.
+// Segments a stream of depth images. It keeps its buffers between frames, so frames of one
+// size allocate nothing after the first (fresh pages cost as much as the work at 256x212).
+class DepthSegmenter {
+ public:
+  explicit DepthSegmenter(const DepthSegmentationParams& params = {});
+
+  // depth: 1 channel, metres along the optical axis, 0 or non-finite = no measurement. The
+  // result stays valid until the next call.
+  const DepthSegmentation& segment(const ImageF& depth, const Intrinsics& intrinsics);
+
+ private:
+  // A horizontal run of non-edge pixels [begin, end) of one row, a node of the union-find.
+  struct Run {
+    int row, begin, end;
+  };
+  struct Offset {
+    int dx, dy;
+  };
+  void compute_vertices_and_normals(const ImageF& depth, const Intrinsics& intrinsics);
+  void detect_edges();
+  void label_components();
+  void fill_edges();
+  int find_root(int run);
+
+  DepthSegmentationParams params_;
+  int width_ = 0, height_ = 0;
+  // Vertex and normal maps as planes (x, y, z); no depth: vertex z = 0; no normal: all 0.
+  std::vector<float> vertex_[3], normal_[3];
+  std::vector<Offset> fill_window_;  // the edge fill's search order
+  std::vector<Run> runs_;
+  std::vector<int> run_parent_, component_size_, label_of_root_;
+  std::vector<std::int32_t> component_;  // labels before the edge fill
+  DepthSegmentation result_;
+};
+
+// One image; see DepthSegmenter.
 DepthSegmentation segment_depth(const ImageF& depth, const Intrinsics& intrinsics,
                                 const DepthSegmentationParams& params = {});
 

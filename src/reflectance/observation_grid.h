@@ -108,6 +108,12 @@ class ObservationGrid {
   std::int32_t& segment(int v) { return segment_[v]; }
   std::int32_t segment(int v) const { return segment_[v]; }
   std::int16_t& segment_confidence(int v) { return segment_confidence_[v]; }
+  // Asks for voxel v's segment id and confidence ahead of use (the voxels of a frame lie
+  // scattered in the pools).
+  void prefetch_segment(int v) const {
+    __builtin_prefetch(&segment_[v], 1);
+    __builtin_prefetch(&segment_confidence_[v], 1);
+  }
   Eigen::Vector3f& refined_kd(int v) { return refined_kd_[v]; }
   const Eigen::Vector3f& refined_kd(int v) const { return refined_kd_[v]; }
   bool& has_refined_kd(int v) { return has_refined_kd_[v]; }

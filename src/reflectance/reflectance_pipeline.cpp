@@ -1,5 +1,6 @@
 #include "reflectance/reflectance_pipeline.h"
 
+#include <algorithm>
 #include <string>
 
 #include "core/error.h"
@@ -17,6 +18,14 @@ SpecularParams with_saturation(SpecularParams params, float exposure) {
   return params;
 }
 
+// min_segment_px is given at full resolution; each halving quarters it.
+DepthSegmentationParams halved_segmentation_params(const ReflectanceParams& params) {
+  DepthSegmentationParams halved = params.segmentation;
+  for (int level = 0; level < params.segmentation_halvings; ++level)
+    halved.min_segment_px = std::max(1, halved.min_segment_px / 4);
+  return halved;
+}
+
 }  // namespace
 
 ReflectancePipeline::ReflectancePipeline(const Intrinsics& intrinsics,
@@ -27,6 +36,7 @@ ReflectancePipeline::ReflectancePipeline(const Intrinsics& intrinsics,
       geometry_(intrinsics, params.geometry),
       grid_(params.observations),
       segment_map_(params.segments),
+      depth_segmenter_(halved_segmentation_params(params)),
       specular_(network, with_saturation(params.specular, params.exposure)),
       lights_(std::move(lights)) {
   if (params.albedo_refresh_frames < 1)
@@ -57,25 +67,28 @@ void ReflectancePipeline::refine_albedo_of_visible() {
   });
 }
 
-Image<std::int32_t> ReflectancePipeline::segment_frame(const ImageF& depth_m) const {
-  ImageF depth = depth_m;
-  Intrinsics intrinsics = intrinsics_;
-  DepthSegmentationParams params = params_.segmentation;
-  for (int level = 0; level < params_.segmentation_halvings; ++level) {
-    depth = fusion::downsample_depth(depth, params_.geometry.tracking.bilateral.sigma_depth_m);
-    intrinsics = intrinsics.scaled(0.5);
-    params.min_segment_px = std::max(1, params.min_segment_px / 4);
-  }
-  const DepthSegmentation coarse = segment_depth(depth, intrinsics, params);
-  if (params_.segmentation_halvings == 0) return coarse.labels;
-  // Every full-resolution pixel takes the label of the coarse pixel covering it.
+const Image<std::int32_t>& ReflectancePipeline::segment_frame(const ImageF& depth_m) {
   const int shift = params_.segmentation_halvings;
-  Image<std::int32_t> labels(depth_m.width(), depth_m.height(), 1);
-  for (int y = 0; y < labels.height(); ++y)
-    for (int x = 0; x < labels.width(); ++x)
-      labels.at(x, y, 0) = coarse.labels.at(std::min(x >> shift, depth.width() - 1),
-                                            std::min(y >> shift, depth.height() - 1), 0);
-  return labels;
+  ImageF halved;
+  Intrinsics intrinsics = intrinsics_;
+  for (int level = 0; level < shift; ++level) {
+    halved = fusion::downsample_depth(level == 0 ? depth_m : halved,
+                                      params_.geometry.tracking.bilateral.sigma_depth_m);
+    intrinsics = intrinsics.scaled(0.5);
+  }
+  const ImageF& depth = shift == 0 ? depth_m : halved;
+  const Image<std::int32_t>& coarse = depth_segmenter_.segment(depth, intrinsics).labels;
+  if (shift == 0) return coarse;
+  // Every full-resolution pixel takes the label of the coarse pixel covering it.
+  if (frame_labels_.width() != depth_m.width() || frame_labels_.height() != depth_m.height())
+    frame_labels_ = Image<std::int32_t>(depth_m.width(), depth_m.height(), 1);
+  parallel_for(std::size_t(depth_m.height()), [&](std::size_t row) {
+    const int y = std::min(int(row) >> shift, depth.height() - 1);
+    std::int32_t* out = frame_labels_.plane(0) + row * depth_m.width();
+    for (int x = 0; x < depth_m.width(); ++x)
+      out[x] = coarse.at(std::min(x >> shift, depth.width() - 1), y, 0);
+  });
+  return frame_labels_;
 }
 
 ReflectanceFrame ReflectancePipeline::process(const io::RgbdFrame& frame,

@@ -77,13 +77,16 @@ class ReflectancePipeline {
 
  private:
   void refine_albedo_of_visible();
-  Image<std::int32_t> segment_frame(const ImageF& depth_m) const;
+  // The depth segmentation's labels at full resolution, in frame_labels_.
+  const Image<std::int32_t>& segment_frame(const ImageF& depth_m);
 
   Intrinsics intrinsics_;
   ReflectanceParams params_;
   fusion::FusionPipeline geometry_;
   ObservationGrid grid_;
   SegmentMap segment_map_;
+  DepthSegmenter depth_segmenter_;      // at the halved resolution
+  Image<std::int32_t> frame_labels_;  // scratch of segment_frame()
   SpecularEstimator specular_;
   std::vector<render::PointLight> lights_;
   StageTimings timings_;

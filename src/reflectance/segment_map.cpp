@@ -1,10 +1,15 @@
 #include "reflectance/segment_map.h"
 
 #include <algorithm>
-#include <map>
 #include <numeric>
 
 namespace glint::reflectance {
+namespace {
+
+// How many visible voxels ahead update() asks for a voxel's segment id.
+constexpr std::size_t kPrefetchDistance = 16;
+
+}  // namespace
 
 SegmentMap::Ring& SegmentMap::ring(int segment) {
   if (segment >= int(segments_.size())) segments_.resize(segment + 1);
@@ -58,19 +63,63 @@ void SegmentMap::merge(ObservationGrid& grid, int kept, int gone) {
 void SegmentMap::update(ObservationGrid& grid, const std::vector<VisibleVoxel>& visible,
                         const Image<std::int32_t>& frame_labels, bool labels_are_global) {
   const std::int32_t* labels = frame_labels.plane(0);
-  std::map<int, int> global_of_label;
+  // One slot per distinct frame label the visible voxels carry (neighbouring voxels mostly
+  // share one, so the hash is consulted only when the label changes).
+  slot_of_label_.clear();
+  slot_label_.clear();
+  voxel_slot_.resize(visible.size());
+  for (std::size_t k = 0, last_label = 0, last_slot = 0; k < visible.size(); ++k) {
+    const std::int32_t label = labels[visible[k].pixel];
+    if (label <= 0) {
+      voxel_slot_[k] = -1;
+      continue;
+    }
+    if (std::size_t(label) != last_label) {
+      const auto [found, added] = slot_of_label_.try_emplace(label, int(slot_label_.size()));
+      if (added) slot_label_.push_back(label);
+      last_label = std::size_t(label);
+      last_slot = std::size_t(found->second);
+    }
+    voxel_slot_[k] = int(last_slot);
+  }
+  const std::size_t slots = slot_label_.size();
+  slot_segment_.assign(slots, 0);  // 0 = the label gets no global id this frame
   if (labels_are_global) {
-    for (const VisibleVoxel& seen : visible)
-      if (labels[seen.pixel] > 0) global_of_label[labels[seen.pixel]] = labels[seen.pixel];
+    for (std::size_t slot = 0; slot < slots; ++slot) slot_segment_[slot] = slot_label_[slot];
   } else {
     // Overlap of every frame label with the global ids its voxels carry (0 = none yet).
-    std::map<int, std::map<int, int>> overlap;
-    for (const VisibleVoxel& seen : visible)
-      if (labels[seen.pixel] > 0) ++overlap[labels[seen.pixel]][grid.segment(seen.voxel)];
-    for (const auto& [label, raw_counts] : overlap) {
-      // Ids merged earlier in this frame count as the segment they went into.
-      std::map<int, int> counts;
-      for (const auto& [id, count] : raw_counts) counts[id > 0 ? resolve(id) : 0] += count;
+    if (slot_overlap_.size() < slots) slot_overlap_.resize(slots);
+    for (std::size_t slot = 0; slot < slots; ++slot) slot_overlap_[slot].clear();
+    for (std::size_t k = 0; k < visible.size(); ++k) {
+      if (k + kPrefetchDistance < visible.size())
+        grid.prefetch_segment(visible[k + kPrefetchDistance].voxel);
+      if (voxel_slot_[k] < 0) continue;
+      std::vector<std::pair<int, int>>& overlap = slot_overlap_[voxel_slot_[k]];
+      const int id = grid.segment(visible[k].voxel);
+      const auto entry = std::find_if(overlap.begin(), overlap.end(),
+                                      [id](const std::pair<int, int>& e) { return e.first == id; });
+      if (entry != overlap.end())
+        ++entry->second;
+      else
+        overlap.emplace_back(id, 1);
+    }
+    // Labels in ascending order: new global ids are handed out in that order.
+    slot_order_.resize(slots);
+    std::iota(slot_order_.begin(), slot_order_.end(), 0);
+    std::sort(slot_order_.begin(), slot_order_.end(),
+              [&](int a, int b) { return slot_label_[a] < slot_label_[b]; });
+    for (const int slot : slot_order_) {
+      // Ids merged earlier in this frame count as the segment they went into; ascending ids.
+      std::vector<std::pair<int, int>>& counts = slot_overlap_[slot];
+      for (auto& [id, count] : counts) id = id > 0 ? resolve(id) : 0;
+      std::sort(counts.begin(), counts.end());
+      std::size_t distinct = 0;
+      for (const auto& entry : counts)
+        if (distinct > 0 && counts[distinct - 1].first == entry.first)
+          counts[distinct - 1].second += entry.second;
+        else
+          counts[distinct++] = entry;
+      counts.resize(distinct);
       int total = 0, best_id = 0, best_count = 0;
       for (const auto& [id, count] : counts) {
         total += count;
@@ -82,22 +131,26 @@ void SegmentMap::update(ObservationGrid& grid, const std::vector<VisibleVoxel>& 
           merge(grid, best_id, id);  // one surface in this frame, two segments so far
           best_count += count;
         }
-      if (best_id > 0 && best_count >= params_.min_overlap * total)
-        global_of_label[label] = best_id;
-      else if (total >= params_.min_new_segment_voxels) {
-        global_of_label[label] = int(segments_.size());  // a new segment
+      if (best_id > 0 && best_count >= params_.min_overlap * total) {
+        slot_segment_[slot] = best_id;
+      } else if (total >= params_.min_new_segment_voxels) {
+        slot_segment_[slot] = int(segments_.size());  // a new segment
         segments_.emplace_back();
       }
     }
   }
   frame_segments_.clear();
-  for (const VisibleVoxel& seen : visible) {
-    const int label = labels[seen.pixel];
-    if (label <= 0) continue;
-    const auto found = global_of_label.find(label);
-    if (found != global_of_label.end()) assign(grid, seen.voxel, resolve(found->second));
+  for (std::size_t slot = 0; slot < slots; ++slot)
+    if (slot_segment_[slot] > 0) {
+      slot_segment_[slot] = resolve(slot_segment_[slot]);
+      frame_segments_.push_back(slot_segment_[slot]);
+    }
+  for (std::size_t k = 0; k < visible.size(); ++k) {
+    if (k + kPrefetchDistance < visible.size())
+      grid.prefetch_segment(visible[k + kPrefetchDistance].voxel);
+    if (voxel_slot_[k] >= 0 && slot_segment_[voxel_slot_[k]] > 0)
+      assign(grid, visible[k].voxel, slot_segment_[voxel_slot_[k]]);
   }
-  for (const auto& [label, id] : global_of_label) frame_segments_.push_back(resolve(id));
   std::sort(frame_segments_.begin(), frame_segments_.end());
   frame_segments_.erase(std::unique(frame_segments_.begin(), frame_segments_.end()),
                         frame_segments_.end());

@@ -17,6 +17,8 @@
 // images) and are written to the voxels directly.
 #include <cstdint>
 #include <random>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "core/image.h"
@@ -71,6 +73,11 @@ class SegmentMap {
   std::vector<int> frame_segments_;
   std::vector<int> merged_into_;  // by id: the id it was merged into, 0 = none
   int merges_ = 0;
+  // Scratch of update(), kept between frames: a slot per distinct frame label.
+  std::unordered_map<int, int> slot_of_label_;
+  std::vector<int> slot_label_, slot_segment_, slot_order_;
+  std::vector<int> voxel_slot_;                                  // per visible voxel, -1 = none
+  std::vector<std::vector<std::pair<int, int>>> slot_overlap_;  // (global id, voxels)
 };
 
 }  // namespace glint::reflectance
