@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <set>
+#include <utility>
 
 namespace glint::reflectance {
 namespace {
@@ -58,6 +59,32 @@ TEST(DepthSegmentation, DepthDiscontinuitiesAndHolesSeparate) {
   EXPECT_EQ(s.segment_count, 3);                   // near plane, far plane above and below the hole
   EXPECT_EQ(s.labels.at(63 + 12, 47 + 12, 0), 0);  // the hole stays unlabelled (b = 0.12)
   EXPECT_NE(labels_in_columns(s, 5, 50), labels_in_columns(s, 78, 123));
+}
+
+TEST(DepthSegmentation, ASegmenterReusedAcrossFramesAndSizesMatchesAFreshOne) {
+  // One segmenter over frames of two sizes (its buffers kept) gives what a fresh call gives.
+  const ImageF valley =
+      depth_image([](double a, double) { return 2 / (1 + 0.8 * std::abs(a)); });
+  const ImageF steps = depth_image([](double a, double) { return a < 0 ? 1.5f : 2.5f; });
+  const Intrinsics half = kCamera.scaled(0.5);
+  ImageF small_image(half.width, half.height, 1);
+  for (int y = 0; y < half.height; ++y)
+    for (int x = 0; x < half.width; ++x) small_image.at(x, y, 0) = valley.at(2 * x, 2 * y, 0);
+  const ImageF& small = small_image;
+  DepthSegmenter segmenter;
+  for (int round = 0; round < 2; ++round)
+    for (const auto& [depth, camera] : {std::pair{&valley, kCamera}, std::pair{&small, half},
+                                        std::pair{&steps, kCamera}}) {
+      const DepthSegmentation& reused = segmenter.segment(*depth, camera);
+      const DepthSegmentation fresh = segment_depth(*depth, camera);
+      ASSERT_EQ(reused.segment_count, fresh.segment_count);
+      ASSERT_EQ(reused.labels.width(), depth->width());
+      for (int y = 0; y < depth->height(); ++y)
+        for (int x = 0; x < depth->width(); ++x) {
+          ASSERT_EQ(reused.labels.at(x, y, 0), fresh.labels.at(x, y, 0));
+          ASSERT_EQ(reused.edges.at(x, y, 0), fresh.edges.at(x, y, 0));
+        }
+    }
 }
 
 TEST(DepthSegmentation, NoDepthGivesNoSegments) {

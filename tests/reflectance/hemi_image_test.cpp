@@ -5,6 +5,8 @@
 #include <Eigen/LU>
 #include <vector>
 
+#include "core/error.h"
+
 namespace glint::reflectance {
 namespace {
 
@@ -48,6 +50,16 @@ TEST(HemiImage, NearestNeighbourFillSplitsTheDisk) {
     EXPECT_EQ(image[2 * plane + y * 15 + 0], 1.0f);   // left column blue
   }
   for (int i = 0; i < plane; ++i) EXPECT_EQ(image[plane + i], 0.0f);  // no green anywhere
+}
+
+TEST(HemiImage, SizesOutsideTheSupportedRangeAreRejected) {
+  std::vector<float> image(3 * 65 * 65);
+  for (int size : {0, kMinHemiImageSize - 1, kMaxHemiImageSize + 1}) {
+    HemiImageParams params;
+    params.size = size;
+    EXPECT_THROW(make_hemi_image(nullptr, 0, Eigen::Vector3f::UnitZ(), params, image.data()),
+                 Error);
+  }
 }
 
 TEST(HemiImage, NoObservationsGiveABlackImage) {
