@@ -17,9 +17,14 @@ using Eigen::Vector3f;
 constexpr int kNeighbourX[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
 constexpr int kNeighbourY[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
 
+// Read-only view of the vertex and normal planes.
 struct Maps {
   const float *vx, *vy, *vz, *nx, *ny, *nz;
   int width, height;
+  Maps(const std::vector<float> (&vertex)[3], const std::vector<float> (&normal)[3], int w,
+       int h)
+      : vx(vertex[0].data()), vy(vertex[1].data()), vz(vertex[2].data()),
+        nx(normal[0].data()), ny(normal[1].data()), nz(normal[2].data()), width(w), height(h) {}
   Vector3f vertex(std::size_t i) const { return {vx[i], vy[i], vz[i]}; }
 };
 
@@ -103,7 +108,7 @@ void DepthSegmenter::compute_vertices_and_normals(const ImageF& depth, const Int
       vx[i] = v.x(), vy[i] = v.y(), vz[i] = v.z();
     }
   });
-  const Maps m{vx, vy, vz, nx, ny, nz, w, h};
+  const Maps m(vertex_, normal_, w, h);
   parallel_for(std::size_t(h), [&](std::size_t row) {
     const int y = int(row);
     std::fill_n(nx + row * w, w, 0.0f);
@@ -128,8 +133,7 @@ void DepthSegmenter::compute_vertices_and_normals(const ImageF& depth, const Int
 
 void DepthSegmenter::detect_edges() {
   const int w = width_, h = height_, s = params_.neighbour_step_px;
-  const Maps m{vertex_[0].data(), vertex_[1].data(), vertex_[2].data(),
-               normal_[0].data(), normal_[1].data(), normal_[2].data(), w, h};
+  const Maps m(vertex_, normal_, w, h);
   std::uint8_t* edge = result_.edges.plane(0);
   const DepthSegmentationParams& p = params_;
   parallel_for(std::size_t(h), [&](std::size_t row) {

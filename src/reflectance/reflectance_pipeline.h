@@ -28,7 +28,7 @@ struct ReflectanceParams {
   // away, so their far objects lie at 5-5.5 m. The truncation band grows by 0.5 cm per metre
   // of depth instead of VoxelHashing's 1 cm: at 5 m it is then +-4.5 cm instead of +-7 cm
   // (measured on cubes: refined-RGB PSNR 27.63 -> 27.94 dB, geometry 8.3 -> 6.9 ms per frame;
-  // 0.25 cm and less left holes, 27.1 dB and below).
+  // 0.25 cm and less left holes, 26.2 dB and below).
   fusion::FusionParams geometry{
       .volume = {.truncation_per_depth = 0.005, .depth_max_m = 6.0, .colour = false},
       .tracking = {}};
@@ -90,7 +90,7 @@ class ReflectancePipeline {
   fusion::FusionPipeline geometry_;
   ObservationGrid grid_;
   SegmentMap segment_map_;
-  DepthSegmenter depth_segmenter_;      // at the halved resolution
+  DepthSegmenter depth_segmenter_;    // at the resolution segmentation_halvings gives
   Image<std::int32_t> frame_labels_;  // scratch of segment_frame()
   SpecularEstimator specular_;
   std::vector<render::PointLight> lights_;
