@@ -70,10 +70,19 @@ std::size_t voxel_capacity(const ObservationGridParams& params) {
 
 }  // namespace
 
-void ObservationGrid::prefetch_observations(int v) const {
+void ObservationGrid::prefetch_voxel(int v) const {
+  __builtin_prefetch(&observation_count_[v]);
+  __builtin_prefetch(&observation_set_[v]);
+  __builtin_prefetch(&position_[v]);
+  __builtin_prefetch(&normal_[v]);
+  __builtin_prefetch(&segment_[v]);
+}
+
+void ObservationGrid::prefetch_observations(int v, bool for_insertion) const {
   const std::size_t first = first_slot(v);
   prefetch_lines(observations_.get() + first, observation_count_[v] * sizeof(Observation));
-  prefetch_lines(nearest_.get() + first, observation_count_[v] * sizeof(NearestObservation));
+  if (for_insertion)
+    prefetch_lines(nearest_.get() + first, observation_count_[v] * sizeof(NearestObservation));
 }
 
 void ObservationGrid::prefetch_voxel_state(int block) const {
@@ -354,7 +363,7 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
         if (!(measured > 0) || std::fabs(measured - q.z()) > tolerance) continue;
         const Eigen::Vector3f direction = (camera_centre - position_[v]).normalized();
         if (normal_[v].dot(direction) < float(params_.min_view_cosine)) continue;
-        prefetch_observations(v);
+        prefetch_observations(v, true);
         seen[seen_count++] = {local, x, y, direction};
       }
       for (int i = 0; i < seen_count; ++i) {

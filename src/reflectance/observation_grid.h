@@ -103,8 +103,13 @@ class ObservationGrid {
   const Eigen::Vector3f& normal(int v) const { return normal_[v]; }
   int observation_count(int v) const { return observation_count_[v]; }
   const Observation* observations(int v) const { return observations_.get() + first_slot(v); }
-  // Asks for voxel v's stored observations (about 1 KB, usually a cache miss) ahead of use.
-  void prefetch_observations(int v) const;
+  // Asks for voxel v's own state (observation count and slots, surface point, normal, segment)
+  // ahead of use: a frame's voxels lie scattered in the pools.
+  void prefetch_voxel(int v) const;
+  // Asks for voxel v's stored observations (about 1 KB, usually a cache miss) ahead of use, with
+  // `for_insertion` also their nearest-observation entries. Reads the voxel's count and slots,
+  // so prefetch_voxel(v) should come some iterations earlier.
+  void prefetch_observations(int v, bool for_insertion) const;
   std::int32_t& segment(int v) { return segment_[v]; }
   std::int32_t segment(int v) const { return segment_[v]; }
   std::int16_t& segment_confidence(int v) { return segment_confidence_[v]; }

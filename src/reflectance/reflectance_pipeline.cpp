@@ -53,17 +53,27 @@ void ReflectancePipeline::refine_albedo_of_visible() {
     if (!grid_.has_refined_kd(seen.voxel) ||
         (seen.voxel + frame_) % params_.albedo_refresh_frames == 0)
       albedo_due_.push_back(seen.voxel);
-  parallel_for(albedo_due_.size(), [&](std::size_t i) {
-    if (i + 1 < albedo_due_.size()) grid_.prefetch_observations(albedo_due_[i + 1]);
-    const int v = albedo_due_[i];
-    const SegmentMaterial* material = specular_.material(grid_.segment(v));
-    if (!material) return;
-    const auto kd = refine_albedo(grid_.observations(v), grid_.observation_count(v),
-                                  grid_.position(v), grid_.normal(v), lights_, material->ward.ks,
-                                  material->ward.alpha, params_.albedo_average);
-    // Each voxel is written by one iteration only: the due list holds it once.
-    grid_.has_refined_kd(v) = kd.has_value();
-    if (kd) grid_.refined_kd(v) = kd->cwiseMax(0.0f).cwiseMin(1.0f);
+  // The stage waits on memory more than it computes (1.3 us per voxel on office against 0.4 us
+  // with its data in cache), so each chunk runs a two-stage prefetch: a voxel's own state
+  // kVoxelAhead iterations early, then, once that has arrived, its observations.
+  constexpr std::size_t kVoxelAhead = 8, kObservationsAhead = 3;
+  parallel_for_chunks(albedo_due_.size(), 64, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < std::min(begin + kVoxelAhead, end); ++i)
+      grid_.prefetch_voxel(albedo_due_[i]);
+    for (std::size_t i = begin; i < end; ++i) {
+      if (i + kVoxelAhead < end) grid_.prefetch_voxel(albedo_due_[i + kVoxelAhead]);
+      if (i + kObservationsAhead < end)
+        grid_.prefetch_observations(albedo_due_[i + kObservationsAhead], false);
+      const int v = albedo_due_[i];
+      const SegmentMaterial* material = specular_.material(grid_.segment(v));
+      if (!material) continue;
+      const auto kd = refine_albedo(grid_.observations(v), grid_.observation_count(v),
+                                    grid_.position(v), grid_.normal(v), lights_, material->ward.ks,
+                                    material->ward.alpha, params_.albedo_average);
+      // Each voxel is written by one iteration only: the due list holds it once.
+      grid_.has_refined_kd(v) = kd.has_value();
+      if (kd) grid_.refined_kd(v) = kd->cwiseMax(0.0f).cwiseMin(1.0f);
+    }
   });
 }
 
