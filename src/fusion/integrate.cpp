@@ -179,8 +179,8 @@ template <auto depth_at>
   }
 }
 
-using BlockKernel = void (*)(const FrameConstants&, const float[3], float*, float*,
-                             std::int32_t*, const float*, const float*);
+using BlockKernel = void (*)(const FrameConstants&, const float[3], float*, float*, std::int32_t*,
+                             const float*, const float*);
 
 [[gnu::flatten]] void integrate_block_baseline(const FrameConstants& k, const float origin[3],
                                                float* sdf_m, float* weight,
@@ -194,8 +194,7 @@ using BlockKernel = void (*)(const FrameConstants&, const float[3], float*, floa
 [[gnu::target("arch=x86-64-v3"), gnu::flatten]] void integrate_block_x86_64_v3(
     const FrameConstants& k, const float origin[3], float* sdf_m, float* weight,
     std::int32_t* fused_pixel, const float* next_sdf_m, const float* next_weight) {
-  integrate_block<depth_gathered>(k, origin, sdf_m, weight, fused_pixel, next_sdf_m,
-                                  next_weight);
+  integrate_block<depth_gathered>(k, origin, sdf_m, weight, fused_pixel, next_sdf_m, next_weight);
 }
 #endif
 
