@@ -239,6 +239,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"voxel_m", options.params.geometry.volume.voxel_size_m},
          {"observations_per_voxel", options.params.observations.observations_per_voxel},
          {"albedo_average", reflectance::albedo_average_name(options.params.albedo_average)},
+         {"albedo_min_light_cosine", options.params.albedo_min_light_cosine},
          {"specular", specular_name(options.params.specular)},
          {"normals", normals_name(options.params.observations)},
          {"render_normal_radius_m", options.render_normal_radius_m},
@@ -325,6 +326,14 @@ void register_reconstruct_command(CLI::App& app) {
           "per-channel median (robust to mispredicted highlights)")
       ->check(CLI::IsMember({"mean", "median"}))
       ->default_str(reflectance::albedo_average_name(params.albedo_average));
+  command
+      ->add_option("--albedo-min-cosine", params.albedo_min_light_cosine,
+                   "Trust a voxel's refined albedo only where its light's effective incidence "
+                   "cosine reaches this (grazing light makes eq. 7 ill-conditioned); elsewhere "
+                   "the re-renderings and the mesh use the reliable voxels around it (0 = trust "
+                   "all, as the paper)")
+      ->check(CLI::Range(0.0f, 1.0f))
+      ->capture_default_str();
   command
       ->add_option_function<std::string>(
           "--specular",

@@ -74,17 +74,24 @@ void write_material_mesh(const std::string& path,
 
 nlohmann::json materials_json(const reflectance::ReflectancePipeline& pipeline) {
   const reflectance::ObservationGrid& grid = pipeline.observations();
-  std::map<int, std::pair<Eigen::Vector3d, int>> refined;  // sum of refined kd, voxels
+  // Sums of refined kd and their voxels, [0] over all voxels, [1] over the reliable ones; the
+  // mean is over the reliable ones where the segment has any.
+  struct Sum {
+    Eigen::Vector3d kd = Eigen::Vector3d::Zero();
+    int voxels = 0;
+  };
+  std::map<int, std::array<Sum, 2>> refined;
   std::map<int, int> voxels;
   for (int v = 0; v < int(grid.voxel_count()); ++v) {
     const int segment = grid.segment(v);
     if (segment <= 0) continue;
     ++voxels[segment];
     if (!grid.has_refined_kd(v)) continue;
-    auto& [sum, count] = refined[segment];
-    if (count == 0) sum.setZero();
-    sum += grid.refined_kd(v).cast<double>();
-    ++count;
+    std::array<Sum, 2>& sums = refined[segment];
+    for (int reliable = 0; reliable <= int(grid.refined_kd_reliable(v)); ++reliable) {
+      sums[reliable].kd += grid.refined_kd(v).cast<double>();
+      ++sums[reliable].voxels;
+    }
   }
   nlohmann::json segments = nlohmann::json::array();
   for (const auto& [id, material] : pipeline.materials().materials()) {
@@ -96,9 +103,11 @@ nlohmann::json materials_json(const reflectance::ReflectancePipeline& pipeline) 
     entry["lobe_fitted"] = material.fitted;
     entry["last_frame"] = material.last_frame;
     entry["voxels"] = voxels[id];
-    if (refined.count(id) && refined[id].second > 0)
-      entry["kd_refined_mean"] =
-          vector_json((refined[id].first / refined[id].second).cast<float>());
+    if (refined.count(id)) {
+      const auto& sums = refined[id];
+      const Sum& sum = sums[1].voxels > 0 ? sums[1] : sums[0];
+      entry["kd_refined_mean"] = vector_json((sum.kd / sum.voxels).cast<float>());
+    }
     segments.push_back(entry);
   }
   return {{"segments", segments}, {"exposure", pipeline.exposure()}};

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <numeric>
 
 #include "core/error.h"
@@ -30,12 +31,12 @@ AlbedoAverage parse_albedo_average(const std::string& name) {
   throw Error("albedo average", name, "must be mean or median");
 }
 
-std::optional<Eigen::Vector3f> refine_albedo(const Observation* observations, int count,
-                                             const Eigen::Vector3f& position,
-                                             const Eigen::Vector3f& normal,
-                                             const std::vector<render::PointLight>& lights,
-                                             const Eigen::Vector3f& ks, float alpha,
-                                             AlbedoAverage average) {
+std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int count,
+                                           const Eigen::Vector3f& position,
+                                           const Eigen::Vector3f& normal,
+                                           const std::vector<render::PointLight>& lights,
+                                           const Eigen::Vector3f& ks, float alpha,
+                                           AlbedoAverage average) {
   std::array<const Observation*, kMaxObservationsPerVoxel> seen;  // from above the surface
   // Their directions as arrays, for the batched lobe.
   std::array<float, kMaxObservationsPerVoxel> x, y, z;
@@ -56,10 +57,14 @@ std::optional<Eigen::Vector3f> refine_albedo(const Observation* observations, in
   std::fill_n(specular.begin(), used, Eigen::Vector3f::Zero());
   std::array<float, kMaxObservationsPerVoxel> lobe;
   Eigen::Vector3f diffuse = Eigen::Vector3f::Zero();  // sum_l L_l cos(theta_i,l)
+  float cosines = 0, sines = 0;                       // the same, luminance, and with sin
   for (const render::PointLight& light : lights) {
     const Incidence in = incidence(light, position, normal);
     if (in.irradiance.isZero()) continue;  // the light is behind the surface
     diffuse += in.irradiance;
+    const float luminance = in.irradiance.mean();  // L_l cos(theta_i,l), mean over channels
+    cosines += luminance;
+    sines += luminance / in.cosine * std::sqrt(std::max(0.0f, 1 - in.cosine * in.cosine));
     render::ward_specular_lobes(normal, in.direction, {x.data(), y.data(), z.data()}, used, alpha,
                                 lobe.data());
     for (int j = 0; j < used; ++j) specular[j] += in.irradiance * lobe[j];
@@ -67,7 +72,9 @@ std::optional<Eigen::Vector3f> refine_albedo(const Observation* observations, in
   if (diffuse.minCoeff() <= 1e-12f) return std::nullopt;
 
   // Eq. (7) per observation and channel.
-  Eigen::Vector3f kd;
+  RefinedAlbedo refined;
+  refined.light_cosine = cosines / std::sqrt(cosines * cosines + sines * sines);
+  Eigen::Vector3f& kd = refined.kd;
   std::array<float, kMaxObservationsPerVoxel> values;
   for (int c = 0; c < 3; ++c) {
     for (int j = 0; j < used; ++j)
@@ -76,7 +83,7 @@ std::optional<Eigen::Vector3f> refine_albedo(const Observation* observations, in
                 ? median(values.data(), used)
                 : std::accumulate(values.begin(), values.begin() + used, 0.0f) / float(used);
   }
-  return kd;
+  return refined;
 }
 
 }  // namespace glint::reflectance

@@ -27,6 +27,55 @@ Eigen::Vector3f shade_ward(const render::WardMaterial& material, const Eigen::Ve
   return radiance;
 }
 
+namespace {
+
+// Refined albedos around a point and their interpolation weights.
+struct WeightedAlbedos {
+  static constexpr int kCapacity = 64;  // the 4^3 voxels around a cell
+  int count = 0;
+  std::array<float, kCapacity> weight, luminance;
+  std::array<Eigen::Vector3f, kCapacity> albedo;
+
+  void add(float w, const Eigen::Vector3f& kd) {
+    weight[count] = w;
+    albedo[count] = kd;
+    luminance[count] = kd.mean();
+    ++count;
+  }
+};
+
+// Weighted mean of the albedos. A voxel whose normal or surface point misses a crease predicts
+// too little or too much irradiance, and its eq. (7) albedo comes out near 0 or 1: among four or
+// more, a minority (at most a quarter) whose mean albedo is more than half off their median is
+// left out; a texture edge through the cell splits them more evenly and stays. (The 0.01 keeps
+// near-black ones from all being outliers of one another.)
+bool blend_without_outliers(const WeightedAlbedos& around, Eigen::Vector3f& kd) {
+  const int n = around.count;
+  if (n == 0) return false;
+  std::array<float, WeightedAlbedos::kCapacity> sorted = around.luminance;
+  std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.begin() + n);
+  const float median = sorted[n / 2];
+  std::array<bool, WeightedAlbedos::kCapacity> outlier;
+  int outliers = 0;
+  for (int k = 0; k < n; ++k) {
+    outlier[k] = std::abs(around.luminance[k] - median) > kRefinedKdOutlier * median + 0.01f;
+    outliers += outlier[k];
+  }
+  const bool leave_out = n >= 4 && 4 * outliers <= n;
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  float weights = 0;
+  for (int k = 0; k < n; ++k) {
+    if (leave_out && outlier[k]) continue;
+    sum += around.weight[k] * around.albedo[k];
+    weights += around.weight[k];
+  }
+  if (!(weights > 1e-6f)) return false;
+  kd = sum / weights;
+  return true;
+}
+
+}  // namespace
+
 bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& p, int segment,
                             Eigen::Vector3f& kd) {
   // Voxel centres sit at (i + 0.5) * size: the 8 around p start at floor(p / size - 0.5).
@@ -34,45 +83,31 @@ bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& 
   const Eigen::Vector3i base(int(std::floor(g.x())), int(std::floor(g.y())),
                              int(std::floor(g.z())));
   const Eigen::Vector3f t = g - base.cast<float>();
-  std::array<float, 8> weight, luminance;
-  std::array<Eigen::Vector3f, 8> albedo;
-  int corners = 0;
+  const auto refined_of_segment = [&](const Eigen::Vector3i& voxel) {
+    const int v = grid.find_voxel(voxel);
+    return v >= 0 && grid.segment(v) == segment && grid.has_refined_kd(v) ? v : -1;
+  };
+  WeightedAlbedos reliable, unreliable;
   for (int c = 0; c < 8; ++c) {
-    const Eigen::Vector3i corner = base + Eigen::Vector3i(c & 1, (c >> 1) & 1, (c >> 2) & 1);
-    const int v = grid.find_voxel(corner);
-    if (v < 0 || grid.segment(v) != segment || !grid.has_refined_kd(v)) continue;
-    weight[corners] = ((c & 1) ? t.x() : 1 - t.x()) * (((c >> 1) & 1) ? t.y() : 1 - t.y()) *
-                      (((c >> 2) & 1) ? t.z() : 1 - t.z());
-    albedo[corners] = grid.refined_kd(v);
-    luminance[corners] = albedo[corners].mean();
-    ++corners;
+    const int v = refined_of_segment(base + Eigen::Vector3i(c & 1, (c >> 1) & 1, (c >> 2) & 1));
+    if (v < 0) continue;
+    const float weight = ((c & 1) ? t.x() : 1 - t.x()) * (((c >> 1) & 1) ? t.y() : 1 - t.y()) *
+                         (((c >> 2) & 1) ? t.z() : 1 - t.z());
+    (grid.refined_kd_reliable(v) ? reliable : unreliable).add(weight, grid.refined_kd(v));
   }
-  if (corners == 0) return false;
-  // A voxel whose normal or surface point misses a crease predicts too little or too much
-  // irradiance, and its eq. (7) albedo comes out near 0 or 1. Among four or more corners, a
-  // minority (at most a quarter) whose mean albedo is more than half off the corners' median is
-  // left out; a texture edge through the cell splits the corners more evenly and stays.
-  // (The 0.01 keeps near-black corners from all being outliers of one another.)
-  std::array<float, 8> sorted = luminance;
-  std::nth_element(sorted.begin(), sorted.begin() + corners / 2, sorted.begin() + corners);
-  const float median = sorted[corners / 2];
-  std::array<bool, 8> outlier;
-  int outliers = 0;
-  for (int k = 0; k < corners; ++k) {
-    outlier[k] = std::abs(luminance[k] - median) > kRefinedKdOutlier * median + 0.01f;
-    outliers += outlier[k];
+  if (reliable.count == 0) {
+    // No corner is reliable: the reliable voxels one further out, under a tent twice as wide.
+    for (int dz = -1; dz <= 2; ++dz)
+      for (int dy = -1; dy <= 2; ++dy)
+        for (int dx = -1; dx <= 2; ++dx) {
+          const int v = refined_of_segment(base + Eigen::Vector3i(dx, dy, dz));
+          if (v < 0 || !grid.refined_kd_reliable(v)) continue;
+          const Eigen::Vector3f d = (t - Eigen::Vector3f(dx, dy, dz)).cwiseAbs();
+          const float weight = (1 - 0.5f * d.x()) * (1 - 0.5f * d.y()) * (1 - 0.5f * d.z());
+          reliable.add(weight, grid.refined_kd(v));
+        }
   }
-  const bool leave_out = corners >= 4 && 4 * outliers <= corners;
-  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-  float weights = 0;
-  for (int k = 0; k < corners; ++k) {
-    if (leave_out && outlier[k]) continue;
-    sum += weight[k] * albedo[k];
-    weights += weight[k];
-  }
-  if (!(weights > 1e-6f)) return false;
-  kd = sum / weights;
-  return true;
+  return blend_without_outliers(reliable.count > 0 ? reliable : unreliable, kd);
 }
 
 namespace {

@@ -33,9 +33,12 @@ Eigen::Vector3f shade_ward(const render::WardMaterial& material, const Eigen::Ve
                            const std::vector<render::PointLight>& lights);
 
 // Refined kd at p: trilinear weights of the 8 observation voxels around p, restricted to those
-// of `segment` with a refined albedo, less a minority of outliers (at most a quarter of four or
-// more corners, mean albedo off the corners' median by more than kRefinedKdOutlier of it),
-// renormalised; false when there is none.
+// of `segment` with a refined albedo, and of those to the reliable ones (solved under light
+// that is not grazing, ObservationGrid::refined_kd_reliable) where there are any; with none
+// reliable, the reliable voxels of the 4^3 around p under a tent of twice the width, and only
+// without those the unreliable corners. Less a minority of outliers (at most a quarter of four
+// or more, mean albedo off their median by more than kRefinedKdOutlier of it), renormalised;
+// false when there is none.
 inline constexpr float kRefinedKdOutlier = 0.5f;
 bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& p, int segment,
                             Eigen::Vector3f& kd);

@@ -146,6 +146,7 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
   segment_ = voxel_pool<std::int32_t>(voxels);
   segment_confidence_ = voxel_pool<std::int16_t>(voxels);
   has_refined_kd_ = voxel_pool<bool>(voxels);
+  refined_kd_reliable_ = voxel_pool<bool>(voxels);
   block_last_frame_ = std::make_unique<std::atomic<int>[]>(hash_.capacity());
   for (std::size_t i = 0; i < hash_.capacity(); ++i) block_last_frame_[i] = -1;
 }

@@ -123,6 +123,10 @@ class ObservationGrid {
   const Eigen::Vector3f& refined_kd(int v) const { return refined_kd_[v]; }
   bool& has_refined_kd(int v) { return has_refined_kd_[v]; }
   bool has_refined_kd(int v) const { return has_refined_kd_[v]; }
+  // Whether the refined albedo was solved under light steep enough to trust it
+  // (RefinedAlbedo::light_cosine, ReflectanceParams::albedo_min_light_cosine).
+  bool& refined_kd_reliable(int v) { return refined_kd_reliable_[v]; }
+  bool refined_kd_reliable(int v) const { return refined_kd_reliable_[v]; }
 
   // Pool index of the voxel containing world point p, or -1.
   int find(const Eigen::Vector3f& p) const;
@@ -190,7 +194,7 @@ class ObservationGrid {
   PoolArray<bool> has_surface_;
   PoolArray<std::int32_t> segment_;
   PoolArray<std::int16_t> segment_confidence_;
-  PoolArray<bool> has_refined_kd_;
+  PoolArray<bool> has_refined_kd_, refined_kd_reliable_;
 
   std::vector<VisibleVoxel> visible_;
 };

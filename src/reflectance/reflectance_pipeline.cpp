@@ -41,6 +41,8 @@ ReflectancePipeline::ReflectancePipeline(const Intrinsics& intrinsics,
       lights_(std::move(lights)) {
   if (params.albedo_refresh_frames < 1)
     throw Error("reflectance pipeline", "albedo_refresh_frames", "must be >= 1");
+  if (!(params.albedo_min_light_cosine >= 0 && params.albedo_min_light_cosine <= 1))
+    throw Error("reflectance pipeline", "albedo_min_light_cosine", "must be in [0, 1]");
   if (lights_.empty())
     throw Error("reflectance pipeline", "lights",
                 "needs at least one light (estimate them with `glint lights`)");
@@ -67,12 +69,14 @@ void ReflectancePipeline::refine_albedo_of_visible() {
       const int v = albedo_due_[i];
       const SegmentMaterial* material = specular_.material(grid_.segment(v));
       if (!material) continue;
-      const auto kd = refine_albedo(grid_.observations(v), grid_.observation_count(v),
-                                    grid_.position(v), grid_.normal(v), lights_, material->ward.ks,
-                                    material->ward.alpha, params_.albedo_average);
+      const auto refined = refine_albedo(
+          grid_.observations(v), grid_.observation_count(v), grid_.position(v), grid_.normal(v),
+          lights_, material->ward.ks, material->ward.alpha, params_.albedo_average);
       // Each voxel is written by one iteration only: the due list holds it once.
-      grid_.has_refined_kd(v) = kd.has_value();
-      if (kd) grid_.refined_kd(v) = kd->cwiseMax(0.0f).cwiseMin(1.0f);
+      grid_.has_refined_kd(v) = refined.has_value();
+      if (!refined) continue;
+      grid_.refined_kd(v) = refined->kd.cwiseMax(0.0f).cwiseMin(1.0f);
+      grid_.refined_kd_reliable(v) = refined->light_cosine >= params_.albedo_min_light_cosine;
     }
   });
 }

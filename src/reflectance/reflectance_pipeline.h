@@ -48,6 +48,12 @@ struct ReflectanceParams {
   // median, chosen on the cubes scene (refined-kd L1 0.044 -> 0.041, refined-RGB PSNR +0.3 dB
   // over the paper's mean), departs from the paper's mean; --albedo-average mean restores it.
   AlbedoAverage albedo_average = AlbedoAverage::median;
+  // A voxel whose albedo was solved under light more grazing than this effective incidence
+  // cosine (RefinedAlbedo::light_cosine) is unreliable: the re-rendering interpolates the
+  // reliable voxels around it instead where there are any (reflectance/material_maps.h). 0.2
+  // (78 degrees) is where a 2-degree normal error makes a 17 % albedo error; it was not tuned.
+  // 0 trusts every voxel, as the paper does.
+  float albedo_min_light_cosine = 0.2f;
   // Radiance = pixel colour / exposure; the lights are in the same radiance units
   // (reflectance/light_estimation.h).
   float exposure = 1;

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 #include "core/error.h"
@@ -37,15 +38,15 @@ TEST(AlbedoRefinement, RecoversTheDiffuseAlbedoOfARenderedVoxel) {
   mirror.direction = 2 * normal.dot(wi) * normal - wi;
   mirror.colour = observed(m, position, normal, mirror.direction, lights);
   obs.push_back(mirror);
-  const auto kd =
+  const auto refined =
       refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks, m.alpha);
-  ASSERT_TRUE(kd.has_value());
-  EXPECT_TRUE(kd->isApprox(m.kd, 1e-4f)) << kd->transpose();
+  ASSERT_TRUE(refined.has_value());
+  EXPECT_TRUE(refined->kd.isApprox(m.kd, 1e-4f)) << refined->kd.transpose();
 
   // Ignoring the specular part over-estimates kd: the refinement does use ks and alpha.
   const auto diffuse_only = refine_albedo(obs.data(), int(obs.size()), position, normal, lights,
                                           Eigen::Vector3f::Zero(), m.alpha);
-  EXPECT_GT(diffuse_only->x(), m.kd.x() + 0.01f);
+  EXPECT_GT(diffuse_only->kd.x(), m.kd.x() + 0.01f);
 }
 
 TEST(AlbedoRefinement, MedianIgnoresAMispredictedHighlight) {
@@ -71,10 +72,38 @@ TEST(AlbedoRefinement, MedianIgnoresAMispredictedHighlight) {
                                   m.alpha, AlbedoAverage::mean);
   ASSERT_TRUE(median && mean);
   // Each clean observation alone gives kd exactly; the median is one of them.
-  EXPECT_TRUE(median->isApprox(m.kd, 1e-4f)) << median->transpose();
-  EXPECT_GT(mean->x(), m.kd.x() + 0.05f);
+  EXPECT_TRUE(median->kd.isApprox(m.kd, 1e-4f)) << median->kd.transpose();
+  EXPECT_GT(mean->kd.x(), m.kd.x() + 0.05f);
   EXPECT_EQ(parse_albedo_average("median"), AlbedoAverage::median);
   EXPECT_THROW(parse_albedo_average("mode"), Error);
+}
+
+TEST(AlbedoRefinement, LightCosineIsTheEffectiveIncidenceOfTheLights) {
+  Observation o;
+  o.direction = Eigen::Vector3f::UnitY();
+  o.colour = {0.5f, 0.5f, 0.5f};
+  const Eigen::Vector3f normal = Eigen::Vector3f::UnitY();
+  const auto light_cosine = [&](const std::vector<render::PointLight>& lights) {
+    return refine_albedo(&o, 1, Eigen::Vector3f::Zero(), normal, lights, {0, 0, 0}, 0.1f)
+        ->light_cosine;
+  };
+  // One light at 60 degrees from the normal: cos 60.
+  std::vector<render::PointLight> lights(1);
+  lights[0].position = {std::sqrt(3.0), 1.0, 0.0};
+  lights[0].intensity = {2, 2, 2};
+  EXPECT_NEAR(light_cosine(lights), 0.5f, 1e-5f);
+  // Two equal lights at 0 and 80 degrees from the normal, the same distance away:
+  // t = (0 + sin 80) / (1 + cos 80).
+  lights.resize(2);
+  const double theta = 80 * M_PI / 180;
+  lights[0].position = {0, 2, 0};
+  lights[1].position = {2 * std::sin(theta), 2 * std::cos(theta), 0};
+  lights[1].intensity = lights[0].intensity;
+  const double t = std::sin(theta) / (1 + std::cos(theta));
+  EXPECT_NEAR(light_cosine(lights), 1 / std::sqrt(1 + t * t), 1e-5);
+  // A grazing light alone.
+  lights.erase(lights.begin());
+  EXPECT_NEAR(light_cosine(lights), std::cos(theta), 1e-5);
 }
 
 TEST(AlbedoRefinement, UnlitOrUnseenVoxelsHaveNoEstimate) {

@@ -26,7 +26,8 @@ TEST(MaterialMaps, ShadingIsEquationSixSummedOverTheLights) {
 }
 
 // Observation voxels (2 cm) of a wall at z = 1.005 m, inside one layer of them (not on a voxel
-// face), all in segment 3 with a refined albedo set by `albedo_at` of their surface point.
+// face), all in segment 3 with a refined albedo set by `albedo_at` of their surface point, and
+// reliable where `reliable_at` says so (everywhere by default).
 class Wall {
  public:
   Wall() : geometry_(volume_params()), grid_(ObservationGridParams{.voxel_capacity = 1 << 14}) {
@@ -37,12 +38,14 @@ class Wall {
     fusion::integrate(geometry_, depth, colour, camera, Pose::Identity(), blocks);
     visible_ = grid_.collect(depth, colour, camera, Pose::Identity(), 1.0f, geometry_, 0);
   }
-  template <class AlbedoAt>
-  ObservationGrid& with_albedo(AlbedoAt albedo_at) {
+  template <class AlbedoAt, class ReliableAt = bool (*)(const Eigen::Vector3f&)>
+  ObservationGrid& with_albedo(
+      AlbedoAt albedo_at, ReliableAt reliable_at = [](const Eigen::Vector3f&) { return true; }) {
     for (const VisibleVoxel& seen : visible_) {
       grid_.segment(seen.voxel) = 3;
       grid_.has_refined_kd(seen.voxel) = true;
       grid_.refined_kd(seen.voxel) = albedo_at(grid_.position(seen.voxel));
+      grid_.refined_kd_reliable(seen.voxel) = reliable_at(grid_.position(seen.voxel));
     }
     return grid_;
   }
@@ -77,6 +80,41 @@ TEST(MaterialMaps, ACornerWhoseAlbedoIsAnOutlierIsLeftOutButATextureEdgeIsNot) {
   ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, kd));
   EXPECT_GT(kd.x(), 0.35f);
   EXPECT_LT(kd.x(), 0.85f);
+}
+
+TEST(MaterialMaps, UnreliableAlbedosGiveWayToTheReliableOnesAround) {
+  Wall wall;
+  ASSERT_GT(wall.voxels(), 20u);
+  const Eigen::Vector3f p(0.013f, -0.007f, 1.005f);
+  // A patch under grazing light, its albedo solved far too bright, on a 0.4 wall.
+  const auto in_patch = [&](const Eigen::Vector3f& q, float radius) {
+    return (q - p).head<2>().norm() < radius;
+  };
+  const auto bright_patch = [&](float radius) {
+    return [&, radius](const Eigen::Vector3f& q) {
+      return Eigen::Vector3f::Constant(in_patch(q, radius) ? 0.95f : 0.4f);
+    };
+  };
+  const auto outside_patch = [&](float radius) {
+    return [&, radius](const Eigen::Vector3f& q) { return !in_patch(q, radius); };
+  };
+  Eigen::Vector3f kd;
+  // Every corner of p's cell in the patch: the reliable voxels one ring further out.
+  ObservationGrid& grid = wall.with_albedo(bright_patch(0.025f), outside_patch(0.025f));
+  ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, kd));
+  EXPECT_NEAR(kd.x(), 0.4f, 1e-6f);
+  // Half the corners (too many to be left out as outliers) in a bright strip: the other half.
+  wall.with_albedo(
+      [](const Eigen::Vector3f& q) {
+        return Eigen::Vector3f::Constant(q.x() < 0.02f ? 0.95f : 0.4f);
+      },
+      [](const Eigen::Vector3f& q) { return q.x() >= 0.02f; });
+  ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, kd));
+  EXPECT_NEAR(kd.x(), 0.4f, 1e-6f);
+  // No reliable voxel near: the unreliable corners after all.
+  wall.with_albedo(bright_patch(0.025f), [](const Eigen::Vector3f&) { return false; });
+  ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, kd));
+  EXPECT_NEAR(kd.x(), 0.95f, 1e-6f);
 }
 
 TEST(MaterialMaps, RefinedAlbedoInterpolatesWithinTheSegmentOnly) {
