@@ -81,17 +81,25 @@ void InsertIntoFullVoxel(benchmark::State& state) {
 BENCHMARK(InsertIntoFullVoxel)->Unit(benchmark::kNanosecond);
 
 // Arg: 0 = the paper's mean of the per-observation albedos, 1 = the median.
+// Cycles through 256 voxels (64 KB of observations, in cache): with a single voxel the branch
+// predictor learnt its median's comparisons, and the median measured 4-5x faster than in the
+// pipeline.
 void RefineAlbedo(benchmark::State& state) {
-  const auto observations = random_observations(30, 5);
+  constexpr int kVoxels = 256;
+  std::vector<std::vector<Observation>> voxels;
+  for (int v = 0; v < kVoxels; ++v) voxels.push_back(random_observations(30, 5 + v));
   std::vector<render::PointLight> lights(3);
   lights[0].position = {0.5, 2.0, 0.3};
   lights[1].position = {-1.5, 1.5, 1.0};
   lights[2].position = {0.0, 1.0, -2.0};
   const AlbedoAverage average = state.range(0) ? AlbedoAverage::median : AlbedoAverage::mean;
-  for (auto _ : state)
-    benchmark::DoNotOptimize(refine_albedo(observations.data(), 30, Eigen::Vector3f::Zero(),
+  int v = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(refine_albedo(voxels[v].data(), 30, Eigen::Vector3f::Zero(),
                                            Eigen::Vector3f::UnitZ(), lights,
                                            Eigen::Vector3f::Constant(0.1f), 0.1f, average));
+    v = (v + 1) % kVoxels;
+  }
 }
 BENCHMARK(RefineAlbedo)->Arg(0)->Arg(1)->Unit(benchmark::kNanosecond);
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <numeric>
 
 #include "core/error.h"
@@ -11,12 +12,65 @@
 namespace glint::reflectance {
 namespace {
 
-// Median of values[0, n), n >= 1; reorders them.
-float median(float* values, int n) {
-  const int middle = n / 2;
-  std::nth_element(values, values + middle, values + n);
-  if (n % 2 == 1) return values[middle];
-  return 0.5f * (values[middle] + *std::max_element(values, values + middle));
+// One observation's eq. (7) albedo: red, green, blue and an unused lane.
+using Channels = float __attribute__((vector_size(4 * sizeof(float))));
+
+// Batcher's odd-even merge sort of kNetworkSize elements as its compare-exchange pairs:
+// (p^2 - p + 4) 2^(p - 2) - 1 = 191 of them for 2^p = 32.
+constexpr int kNetworkSize = 32;
+constexpr std::size_t kNetworkPairs = 191;
+struct CompareExchange {
+  std::uint8_t low = 0, high = 0;
+};
+struct SortingNetwork {
+  std::array<CompareExchange, kNetworkPairs> pairs{};
+  std::size_t count = 0;
+};
+constexpr SortingNetwork merge_sort_network() {
+  SortingNetwork network;
+  for (int p = 1; p < kNetworkSize; p *= 2)
+    for (int k = p; k >= 1; k /= 2)
+      for (int j = k % p; j + k < kNetworkSize; j += 2 * k)
+        for (int i = 0; i < k && i + j + k < kNetworkSize; ++i)
+          if ((i + j) / (2 * p) == (i + j + k) / (2 * p))
+            network.pairs.at(network.count++) = {std::uint8_t(i + j), std::uint8_t(i + j + k)};
+  return network;
+}
+constexpr SortingNetwork kMergeSortNetwork = merge_sort_network();
+static_assert(kMergeSortNetwork.count == kNetworkPairs);
+
+// Median of the sorted values[0, n).
+float median_of_sorted(const float* sorted, int n) {
+  return n % 2 == 1 ? sorted[n / 2] : 0.5f * (sorted[n / 2 - 1] + sorted[n / 2]);
+}
+
+// Per-channel median of values[0, n), 1 <= n <= kMaxObservationsPerVoxel; reorders them.
+// Up to 32 values all three channels are sorted at once by a fixed network of vector min / max:
+// the median by std::nth_element, with branches on the data, mispredicted its way to 0.8 us
+// per voxel (3 channels of 30), three quarters of the albedo stage.
+Eigen::Vector3f channel_medians(Channels* values, int n) {
+  Eigen::Vector3f median;
+  if (n <= kNetworkSize) {
+    std::fill(values + n, values + kNetworkSize, Channels{} + INFINITY);
+    for (const CompareExchange& pair : kMergeSortNetwork.pairs) {
+      const Channels a = values[pair.low], b = values[pair.high];
+      values[pair.low] = a < b ? a : b;
+      values[pair.high] = a < b ? b : a;
+    }
+    for (int c = 0; c < 3; ++c) {
+      std::array<float, kNetworkSize> sorted;
+      for (int j = 0; j < n; ++j) sorted[j] = values[j][c];
+      median[c] = median_of_sorted(sorted.data(), n);
+    }
+    return median;
+  }
+  std::array<float, kMaxObservationsPerVoxel> channel;
+  for (int c = 0; c < 3; ++c) {
+    for (int j = 0; j < n; ++j) channel[j] = values[j][c];
+    std::sort(channel.begin(), channel.begin() + n);
+    median[c] = median_of_sorted(channel.data(), n);
+  }
+  return median;
 }
 
 }  // namespace
@@ -74,14 +128,17 @@ std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int 
   // Eq. (7) per observation and channel.
   RefinedAlbedo refined;
   refined.light_cosine = cosines / std::sqrt(cosines * cosines + sines * sines);
-  Eigen::Vector3f& kd = refined.kd;
-  std::array<float, kMaxObservationsPerVoxel> values;
-  for (int c = 0; c < 3; ++c) {
-    for (int j = 0; j < used; ++j)
-      values[j] = float(M_PI) * (seen[j]->colour[c] - ks[c] * specular[j][c]) / diffuse[c];
-    kd[c] = average == AlbedoAverage::median
-                ? median(values.data(), used)
-                : std::accumulate(values.begin(), values.begin() + used, 0.0f) / float(used);
+  std::array<Channels, std::max(kMaxObservationsPerVoxel, kNetworkSize)> values;
+  for (int j = 0; j < used; ++j) {
+    values[j] = Channels{};
+    for (int c = 0; c < 3; ++c)
+      values[j][c] = float(M_PI) * (seen[j]->colour[c] - ks[c] * specular[j][c]) / diffuse[c];
+  }
+  if (average == AlbedoAverage::median) {
+    refined.kd = channel_medians(values.data(), used);
+  } else {
+    const Channels sum = std::accumulate(values.begin(), values.begin() + used, Channels{});
+    refined.kd = Eigen::Vector3f(sum[0], sum[1], sum[2]) / float(used);
   }
   return refined;
 }

@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include "core/error.h"
@@ -76,6 +79,39 @@ TEST(AlbedoRefinement, MedianIgnoresAMispredictedHighlight) {
   EXPECT_GT(mean->kd.x(), m.kd.x() + 0.05f);
   EXPECT_EQ(parse_albedo_average("median"), AlbedoAverage::median);
   EXPECT_THROW(parse_albedo_average("mode"), Error);
+}
+
+TEST(AlbedoRefinement, MedianIsThePerChannelMedianForEveryCount) {
+  // Diffuse-only observations (ks 0) under one light straight above: observation j's eq. (7)
+  // albedo is its colour * pi / E, so the result is the per-channel median of those.
+  std::vector<render::PointLight> lights(1);
+  lights[0].position = {0, 1, 0};
+  lights[0].intensity = {1, 1, 1};  // E = 1 at the origin
+  const Eigen::Vector3f normal = Eigen::Vector3f::UnitY();
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  for (int n = 1; n <= 40; ++n) {  // across the 32 of the sorting network
+    std::vector<Observation> obs(n);
+    std::array<std::vector<float>, 3> albedos;
+    for (Observation& o : obs) {
+      o.direction = Eigen::Vector3f(uniform(random) - 0.5f, 1, uniform(random) - 0.5f).normalized();
+      for (int c = 0; c < 3; ++c) {
+        // Few distinct values, so that ties occur.
+        const float albedo = std::round(uniform(random) * 8) / 8;
+        o.colour[c] = albedo / float(M_PI);
+        albedos[c].push_back(albedo);
+      }
+    }
+    const auto refined = refine_albedo(obs.data(), n, Eigen::Vector3f::Zero(), normal, lights,
+                                       {0, 0, 0}, 0.1f, AlbedoAverage::median);
+    ASSERT_TRUE(refined);
+    for (int c = 0; c < 3; ++c) {
+      std::sort(albedos[c].begin(), albedos[c].end());
+      const float expected =
+          n % 2 ? albedos[c][n / 2] : 0.5f * (albedos[c][n / 2 - 1] + albedos[c][n / 2]);
+      EXPECT_NEAR(refined->kd[c], expected, 1e-6f) << n << " observations, channel " << c;
+    }
+  }
 }
 
 TEST(AlbedoRefinement, LightCosineIsTheEffectiveIncidenceOfTheLights) {
