@@ -320,31 +320,54 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
 
   // One slot per voxel of the frame's blocks; -1 = not observed.
   visible_.assign(frame_blocks_.size() * voxels_per_block_, VisibleVoxel{-1, -1});
-  // A block's voxels go in two passes: the first refreshes surfaces, tests visibility and
-  // prefetches the observation slots of the visible voxels; the second inserts. Insertion reads
-  // every stored direction of a voxel (~1 KB), so the misses of a whole chunk then overlap
-  // instead of stalling voxel after voxel. The next block's per-voxel state is prefetched too:
-  // the blocks of a frame lie scattered in the pools.
+  // The voxels go in two passes: the first refreshes surfaces, tests visibility and prefetches
+  // the observation slots of the visible voxels; the second inserts. Insertion reads every
+  // stored direction of a voxel (~1 KB), so the misses of a batch of voxels then overlap
+  // instead of stalling voxel after voxel. A batch spans blocks (at 2 cm a block has only 8
+  // voxels, and batches of one block left the misses little time). The next block's per-voxel
+  // state is prefetched too: the blocks of a frame lie scattered in the pools.
   struct Seen {
-    int local, x, y;
+    int voxel, visible_index, x, y;
     Eigen::Vector3f direction;
   };
-  constexpr int kChunk = 64;
+  constexpr int kBatch = 128, kInsertFrom = 32;  // voxels pending, and at least this many
   const std::size_t blocks = frame_blocks_.size();
   const float geometry_blocks_per_block =
       float(params_.block_size_m / geometry.params().block_size_m());
-  parallel_for(blocks, [&](std::size_t slot) {
-    const int block = frame_blocks_[slot];
-    const int next_block = frame_blocks_[slot + 1 < blocks ? slot + 1 : slot];
-    prefetch_voxel_state(next_block);
-    geometry.hash().prefetch(geometry_block(next_block, geometry_blocks_per_block));
-    prefetch_geometry_if_due(geometry, block, frame, geometry_blocks_per_block);
-    fusion::TsdfSampler sampler(geometry);  // its block cache serves the block's voxels
-    const Eigen::Vector3i first_voxel = hash_.block(block) * side_;
-    std::array<Seen, kChunk> seen;
-    for (int chunk = 0; chunk < voxels_per_block_; chunk += kChunk) {
-      int seen_count = 0;
-      for (int local = chunk; local < std::min(chunk + kChunk, voxels_per_block_); ++local) {
+  parallel_for_chunks(blocks, 16, [&](std::size_t begin, std::size_t end) {
+    fusion::TsdfSampler sampler(geometry);  // its block cache serves each block's voxels
+    std::array<Seen, kBatch> seen;
+    int pending = 0;
+    const auto insert_pending = [&] {
+      for (int i = 0; i < pending; ++i) {
+        const Seen& voxel = seen[i];
+        const int v = voxel.voxel;
+        Observation observation;
+        observation.colour =
+            Eigen::Vector3f(colour.at(voxel.x, voxel.y, 0), colour.at(voxel.x, voxel.y, 1),
+                            colour.at(voxel.x, voxel.y, 2)) *
+            inverse_exposure;
+        observation.direction = voxel.direction;
+        observation.frame = std::uint32_t(frame);
+        if (observation_set_[v] == 0)
+          observation_set_[v] = 1 + observation_sets_used_.fetch_add(1, std::memory_order_relaxed);
+        const std::size_t first = first_slot(v);
+        observation_count_[v] =
+            std::uint8_t(insert_observation(observations_.get() + first, nearest_.get() + first,
+                                            observation_count_[v], capacity, observation));
+        visible_[voxel.visible_index] = {v, voxel.y * width + voxel.x};
+      }
+      pending = 0;
+    };
+    for (std::size_t slot = begin; slot < end; ++slot) {
+      if (pending >= kInsertFrom || pending + voxels_per_block_ > kBatch) insert_pending();
+      const int block = frame_blocks_[slot];
+      const int next_block = frame_blocks_[slot + 1 < blocks ? slot + 1 : slot];
+      prefetch_voxel_state(next_block);
+      geometry.hash().prefetch(geometry_block(next_block, geometry_blocks_per_block));
+      prefetch_geometry_if_due(geometry, block, frame, geometry_blocks_per_block);
+      const Eigen::Vector3i first_voxel = hash_.block(block) * side_;
+      for (int local = 0; local < voxels_per_block_; ++local) {
         const Eigen::Vector3i offset(local % side_, (local / side_) % side_,
                                      local / (side_ * side_));
         const int v = block * voxels_per_block_ + local;
@@ -365,27 +388,10 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
         const Eigen::Vector3f direction = (camera_centre - position_[v]).normalized();
         if (normal_[v].dot(direction) < float(params_.min_view_cosine)) continue;
         prefetch_observations(v, true);
-        seen[seen_count++] = {local, x, y, direction};
-      }
-      for (int i = 0; i < seen_count; ++i) {
-        const Seen& voxel = seen[i];
-        const int v = block * voxels_per_block_ + voxel.local;
-        Observation observation;
-        observation.colour =
-            Eigen::Vector3f(colour.at(voxel.x, voxel.y, 0), colour.at(voxel.x, voxel.y, 1),
-                            colour.at(voxel.x, voxel.y, 2)) *
-            inverse_exposure;
-        observation.direction = voxel.direction;
-        observation.frame = std::uint32_t(frame);
-        if (observation_set_[v] == 0)
-          observation_set_[v] = 1 + observation_sets_used_.fetch_add(1, std::memory_order_relaxed);
-        const std::size_t first = first_slot(v);
-        observation_count_[v] =
-            std::uint8_t(insert_observation(observations_.get() + first, nearest_.get() + first,
-                                            observation_count_[v], capacity, observation));
-        visible_[slot * voxels_per_block_ + voxel.local] = {v, voxel.y * width + voxel.x};
+        seen[pending++] = {v, int(slot) * voxels_per_block_ + local, x, y, direction};
       }
     }
+    insert_pending();
   });
   // After all refreshes: a plane fit reads its neighbours' surface points, which the pass above
   // may be writing on another thread.
