@@ -177,6 +177,10 @@ class ObservationGrid {
   fusion::VoxelBlockHash hash_;
   std::unique_ptr<std::atomic<int>[]> block_last_frame_;
   std::vector<int> frame_blocks_;
+  // Per frame block: whether a refresh in this frame found a surface in one of its voxels (the
+  // blocks whose normals are refitted), and the slots of those blocks.
+  std::vector<std::uint8_t> block_refreshed_;
+  std::vector<std::size_t> refit_blocks_;
 
   // Structure-of-arrays voxel pools (zero-initialised, committed on first touch).
   // A voxel's m observation slots are taken from observations_ / nearest_ at its first
