@@ -74,24 +74,29 @@ void write_material_mesh(const std::string& path,
 
 nlohmann::json materials_json(const reflectance::ReflectancePipeline& pipeline) {
   const reflectance::ObservationGrid& grid = pipeline.observations();
-  // Sums of refined kd and their voxels, [0] over all voxels, [1] over the reliable ones; the
-  // mean is over the reliable ones where the segment has any.
+  // Per segment, the sum of the refined kd over all its voxels with one and over the reliable
+  // ones; the mean is over the reliable ones where the segment has any.
   struct Sum {
     Eigen::Vector3d kd = Eigen::Vector3d::Zero();
     int voxels = 0;
+    void add(const Eigen::Vector3f& value) {
+      kd += value.cast<double>();
+      ++voxels;
+    }
   };
-  std::map<int, std::array<Sum, 2>> refined;
+  struct RefinedSums {
+    Sum all, reliable;
+  };
+  std::map<int, RefinedSums> refined;
   std::map<int, int> voxels;
   for (int v = 0; v < int(grid.voxel_count()); ++v) {
     const int segment = grid.segment(v);
     if (segment <= 0) continue;
     ++voxels[segment];
     if (!grid.has_refined_kd(v)) continue;
-    std::array<Sum, 2>& sums = refined[segment];
-    for (int reliable = 0; reliable <= int(grid.refined_kd_reliable(v)); ++reliable) {
-      sums[reliable].kd += grid.refined_kd(v).cast<double>();
-      ++sums[reliable].voxels;
-    }
+    RefinedSums& sums = refined[segment];
+    sums.all.add(grid.refined_kd(v));
+    if (grid.refined_kd_reliable(v)) sums.reliable.add(grid.refined_kd(v));
   }
   nlohmann::json segments = nlohmann::json::array();
   for (const auto& [id, material] : pipeline.materials().materials()) {
@@ -103,9 +108,9 @@ nlohmann::json materials_json(const reflectance::ReflectancePipeline& pipeline) 
     entry["lobe_fitted"] = material.fitted;
     entry["last_frame"] = material.last_frame;
     entry["voxels"] = voxels[id];
-    if (refined.count(id)) {
-      const auto& sums = refined[id];
-      const Sum& sum = sums[1].voxels > 0 ? sums[1] : sums[0];
+    if (const auto found = refined.find(id); found != refined.end()) {
+      const RefinedSums& sums = found->second;
+      const Sum& sum = sums.reliable.voxels > 0 ? sums.reliable : sums.all;
       entry["kd_refined_mean"] = vector_json((sum.kd / sum.voxels).cast<float>());
     }
     segments.push_back(entry);

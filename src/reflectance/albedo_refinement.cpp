@@ -39,12 +39,13 @@ constexpr SortingNetwork merge_sort_network() {
 constexpr SortingNetwork kMergeSortNetwork = merge_sort_network();
 static_assert(kMergeSortNetwork.count == kNetworkPairs);
 
-// Median of the sorted values[0, n).
-float median_of_sorted(const float* sorted, int n) {
-  return n % 2 == 1 ? sorted[n / 2] : 0.5f * (sorted[n / 2 - 1] + sorted[n / 2]);
+// Median of n sorted values, value(j) the j-th.
+template <class Value>
+float median_of_sorted(Value value, int n) {
+  return n % 2 == 1 ? value(n / 2) : 0.5f * (value(n / 2 - 1) + value(n / 2));
 }
 
-// Per-channel median of values[0, n), 1 <= n <= kMaxObservationsPerVoxel; reorders them.
+// Per-channel median of values[0, n), 1 <= n <= kMaxObservationsPerVoxel; may reorder them.
 // Up to 32 values all three channels are sorted at once by a fixed network of vector min / max:
 // the median by std::nth_element, with branches on the data, mispredicted its way to 0.8 us
 // per voxel (3 channels of 30), three quarters of the albedo stage.
@@ -57,18 +58,15 @@ Eigen::Vector3f channel_medians(Channels* values, int n) {
       values[pair.low] = a < b ? a : b;
       values[pair.high] = a < b ? b : a;
     }
-    for (int c = 0; c < 3; ++c) {
-      std::array<float, kNetworkSize> sorted;
-      for (int j = 0; j < n; ++j) sorted[j] = values[j][c];
-      median[c] = median_of_sorted(sorted.data(), n);
-    }
+    for (int c = 0; c < 3; ++c)
+      median[c] = median_of_sorted([&](int j) { return values[j][c]; }, n);
     return median;
   }
   std::array<float, kMaxObservationsPerVoxel> channel;
   for (int c = 0; c < 3; ++c) {
     for (int j = 0; j < n; ++j) channel[j] = values[j][c];
     std::sort(channel.begin(), channel.begin() + n);
-    median[c] = median_of_sorted(channel.data(), n);
+    median[c] = median_of_sorted([&](int j) { return channel[j]; }, n);
   }
   return median;
 }

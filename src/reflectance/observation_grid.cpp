@@ -397,9 +397,9 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
     insert_pending();
   });
   // After all refreshes: a plane fit reads its neighbours' surface points, which the pass above
-  // may be writing on another thread.
-  // Only the blocks with a refreshed surface: testing every block's voxels read their state
-  // from memory again (11,700 blocks per frame on cubes, most without a refresh).
+  // may be writing on another thread. Only the blocks with a refreshed surface: testing every
+  // block's voxels read their state from memory again (11,700 blocks per frame on cubes, most
+  // without a refresh).
   if (params_.normal_from_neighbours) {
     refit_blocks_.clear();
     for (std::size_t slot = 0; slot < blocks; ++slot)
