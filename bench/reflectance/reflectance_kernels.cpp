@@ -5,6 +5,7 @@
 //   reflectance_kernels [--benchmark_out=FILE.json --benchmark_out_format=json]
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <filesystem>
 #include <random>
 #include <vector>
@@ -63,22 +64,40 @@ void HemiImage(benchmark::State& state) {
 }
 BENCHMARK(HemiImage)->Unit(benchmark::kMicrosecond);
 
+// Arg: 0 = each new direction drawn at random over the hemisphere; 1 = directions along a
+// smooth camera path (each close to the one before, as in a video), the pipeline's usual case:
+// the dropped observation is then mostly the newest stored one. Both cycle through 64 voxels so
+// that the branch predictor cannot learn one voxel's comparisons.
 void InsertIntoFullVoxel(benchmark::State& state) {
-  const auto initial = random_observations(30, 3);
-  std::vector<Observation> slots(30);
-  std::vector<NearestObservation> nearest(30);
-  int count = 0;
-  for (const Observation& o : initial)
-    count = insert_observation(slots.data(), nearest.data(), count, 30, o);
-  const auto incoming = random_observations(1024, 4);
+  constexpr int kVoxels = 64;
+  const bool along_path = state.range(0) == 1;
+  std::vector<std::vector<Observation>> slots(kVoxels);
+  std::vector<std::vector<NearestObservation>> nearest(kVoxels);
+  for (int v = 0; v < kVoxels; ++v) {
+    slots[v].resize(30);
+    nearest[v].resize(30);
+    int count = 0;
+    for (const Observation& o : random_observations(30, 3 + v))
+      count = insert_observation(slots[v].data(), nearest[v].data(), count, 30, o);
+  }
+  std::vector<Observation> incoming = random_observations(1024, 4);
+  if (along_path)
+    for (std::size_t k = 0; k < incoming.size(); ++k) {
+      const float t = 0.01f * float(k);  // about 0.6 degrees per frame
+      incoming[k].direction =
+          Eigen::Vector3f(0.6f * std::cos(t), 0.6f * std::sin(1.3f * t), 0.8f).normalized();
+    }
   std::size_t next = 0;
   for (auto _ : state) {
-    Observation added = incoming[next++ % incoming.size()];
+    const int v = int(next % kVoxels);
+    Observation added = incoming[(next / kVoxels) % incoming.size()];
     added.frame = std::uint32_t(100 + next);
-    benchmark::DoNotOptimize(insert_observation(slots.data(), nearest.data(), count, 30, added));
+    ++next;
+    benchmark::DoNotOptimize(
+        insert_observation(slots[v].data(), nearest[v].data(), 30, 30, added));
   }
 }
-BENCHMARK(InsertIntoFullVoxel)->Unit(benchmark::kNanosecond);
+BENCHMARK(InsertIntoFullVoxel)->Arg(0)->Arg(1)->Unit(benchmark::kNanosecond);
 
 // Arg: 0 = the paper's mean of the per-observation albedos, 1 = the median.
 // Cycles through 256 voxels (64 KB of observations, in cache): with a single voxel the branch
