@@ -83,8 +83,9 @@ void run_fuse(const FuseOptions& options) {
     progress.finish();
   }
   Stopwatch mesh_watch;
-  const fusion::TriangleMesh mesh = fusion::extract_mesh(pipeline.volume());
+  fusion::TriangleMesh mesh = fusion::extract_mesh(pipeline.volume());
   command_timings.add("mesh", mesh_watch.elapsed_ms());
+  mesh.comments = {"glint fuse; red green blue: fused colour, 8-bit sRGB"};
   fusion::write_mesh_ply(options.mesh, mesh);
   if (!options.points.empty()) io::write_ply(options.points, mesh_vertices_as_points(mesh));
   if (!options.trajectory.empty()) io::write_tum_trajectory(options.trajectory, trajectory);

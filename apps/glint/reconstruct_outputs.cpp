@@ -69,6 +69,10 @@ void write_material_mesh(const std::string& path,
   const std::array<const char*, 8> names{"kd_r", "kd_g", "kd_b",  "ks_r",
                                          "ks_g", "ks_b", "alpha", "scalar_segment"};
   for (int k = 0; k < 8; ++k) mesh.vertex_properties.emplace_back(names[k], std::move(values[k]));
+  mesh.comments = {
+      "glint reconstruct; red green blue: refined diffuse albedo kd, 8-bit sRGB",
+      "kd_*: refined diffuse albedo, ks_*: specular albedo, alpha: Ward roughness (linear)",
+      "scalar_segment: segment id (0 = none); vertices without a material have zeros"};
   fusion::write_mesh_ply(path, mesh);
 }
 

@@ -42,8 +42,13 @@ void write_mesh_ply(const std::string& path, const TriangleMesh& mesh) {
   io::AtomicFile file(path);
   std::ostream& out = file.stream();
   const bool with_colour = mesh.colours.size() == mesh.vertices.size();
-  out << "ply\nformat binary_little_endian 1.0\ncomment glint fuse (voxel-hashed TSDF)\n"
-      << "element vertex " << mesh.vertices.size() << "\n"
+  out << "ply\nformat binary_little_endian 1.0\ncomment glint: marching cubes of a voxel-hashed TSDF\n";
+  for (const std::string& comment : mesh.comments) {
+    if (comment.find_first_of("\r\n") != std::string::npos)
+      throw Error(path, "comment", "must be a single line: " + comment);
+    out << "comment " << comment << "\n";
+  }
+  out << "element vertex " << mesh.vertices.size() << "\n"
       << "property float x\nproperty float y\nproperty float z\n";
   if (with_colour) out << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   for (const auto& [name, values] : mesh.vertex_properties) {

@@ -8,6 +8,7 @@
 #include <map>
 #include <numbers>
 
+#include "core/error.h"
 #include "fusion/marching_cubes_table.h"
 #include "fusion_test_support.h"
 
@@ -84,6 +85,25 @@ TEST(MarchingCubes, PlyOutputHasHeaderCountsAndColours) {
   EXPECT_EQ(text.size() - body, 3 * 15 + 13u);
   EXPECT_EQ(linear_to_srgb8(1.0f), 255);
   EXPECT_EQ(linear_to_srgb8(0.2158605f), 128);
+}
+
+TEST(MarchingCubes, PlyHeaderCarriesTheCommentsAndRefusesAMultiLineOne) {
+  TriangleMesh mesh;
+  mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  mesh.triangles = {{0, 1, 2}};
+  mesh.comments = {"red green blue: refined diffuse albedo"};
+  const std::string path = ::testing::TempDir() + "/commented.ply";
+  write_mesh_ply(path, mesh);
+  std::ifstream in(path, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), {});
+  const std::size_t comment = text.find("comment red green blue: refined diffuse albedo\n");
+  ASSERT_NE(comment, std::string::npos);
+  EXPECT_LT(comment, text.find("element vertex 3"));
+
+  const std::string refused = ::testing::TempDir() + "/two-line-comment.ply";
+  mesh.comments = {"first line\nend_header"};
+  EXPECT_THROW(write_mesh_ply(refused, mesh), Error);
+  EXPECT_FALSE(std::filesystem::exists(refused));
 }
 
 }  // namespace
