@@ -268,9 +268,10 @@ void register_reconstruct_command(CLI::App& app) {
       "each segment's Ward kd, ks, alpha with the HemiCNN from 25 hemi-images (ks, alpha\n"
       "from a photometric lobe fit to the same voxels where it explains them), fuses them over\n"
       "time, and refines the diffuse albedo per voxel (eq. 7) under the estimated point lights.\n"
-      "Writes OUT/mesh.ply (per-vertex refined kd as colour, kd_r/g/b, segment),\n"
-      "OUT/materials.json, OUT/lights.json, OUT/frames/ (input, re-rendering, albedo), and on\n"
-      "synthetic sequences with gt/ the paper's Table 1 metrics and OUT/materials-over-time.png.");
+      "Writes OUT/mesh.ply (per vertex: refined kd as colour; kd_r/g/b, ks_r/g/b, alpha,\n"
+      "scalar_segment as floats), OUT/materials.json, OUT/lights.json, OUT/frames/ (input,\n"
+      "re-rendering, albedo), and on synthetic sequences with gt/ the paper's Table 1 metrics\n"
+      "and OUT/materials-over-time.png.");
   command->add_option("sequence", options->sequence, "RGB-D sequence folder")->required();
   command->add_option("-o,--output", options->output, "Output folder")->required();
   command->add_option("--lights", options->lights,
