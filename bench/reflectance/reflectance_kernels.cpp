@@ -93,8 +93,7 @@ void InsertIntoFullVoxel(benchmark::State& state) {
     Observation added = incoming[(next / kVoxels) % incoming.size()];
     added.frame = std::uint32_t(100 + next);
     ++next;
-    benchmark::DoNotOptimize(
-        insert_observation(slots[v].data(), nearest[v].data(), 30, 30, added));
+    benchmark::DoNotOptimize(insert_observation(slots[v].data(), nearest[v].data(), 30, 30, added));
   }
 }
 BENCHMARK(InsertIntoFullVoxel)->Arg(0)->Arg(1)->Unit(benchmark::kNanosecond);

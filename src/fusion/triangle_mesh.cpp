@@ -42,7 +42,8 @@ void write_mesh_ply(const std::string& path, const TriangleMesh& mesh) {
   io::AtomicFile file(path);
   std::ostream& out = file.stream();
   const bool with_colour = mesh.colours.size() == mesh.vertices.size();
-  out << "ply\nformat binary_little_endian 1.0\ncomment glint: marching cubes of a voxel-hashed TSDF\n";
+  out << "ply\nformat binary_little_endian 1.0\ncomment glint: marching cubes of a voxel-hashed "
+         "TSDF\n";
   for (const std::string& comment : mesh.comments) {
     if (comment.find_first_of("\r\n") != std::string::npos)
       throw Error(path, "comment", "must be a single line: " + comment);

@@ -37,10 +37,10 @@ struct RefinedAlbedo {
 // reaches the surface point.
 // No allocation.
 std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int count,
-                                             const Eigen::Vector3f& position,
-                                             const Eigen::Vector3f& normal,
-                                             const std::vector<render::PointLight>& lights,
-                                             const Eigen::Vector3f& ks, float alpha,
-                                             AlbedoAverage average = AlbedoAverage::mean);
+                                           const Eigen::Vector3f& position,
+                                           const Eigen::Vector3f& normal,
+                                           const std::vector<render::PointLight>& lights,
+                                           const Eigen::Vector3f& ks, float alpha,
+                                           AlbedoAverage average = AlbedoAverage::mean);
 
 }  // namespace glint::reflectance

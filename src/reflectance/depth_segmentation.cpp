@@ -21,10 +21,15 @@ constexpr int kNeighbourY[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
 struct Maps {
   const float *vx, *vy, *vz, *nx, *ny, *nz;
   int width, height;
-  Maps(const std::vector<float> (&vertex)[3], const std::vector<float> (&normal)[3], int w,
-       int h)
-      : vx(vertex[0].data()), vy(vertex[1].data()), vz(vertex[2].data()),
-        nx(normal[0].data()), ny(normal[1].data()), nz(normal[2].data()), width(w), height(h) {}
+  Maps(const std::vector<float> (&vertex)[3], const std::vector<float> (&normal)[3], int w, int h)
+      : vx(vertex[0].data()),
+        vy(vertex[1].data()),
+        vz(vertex[2].data()),
+        nx(normal[0].data()),
+        ny(normal[1].data()),
+        nz(normal[2].data()),
+        width(w),
+        height(h) {}
   Vector3f vertex(std::size_t i) const { return {vx[i], vy[i], vz[i]}; }
 };
 
@@ -102,9 +107,8 @@ void DepthSegmenter::compute_vertices_and_normals(const ImageF& depth, const Int
     for (int x = 0; x < w; ++x) {
       const std::size_t i = row * w + x;
       const float z = depth.at(x, y, 0);
-      const Vector3f v = std::isfinite(z) && z > 0
-                             ? Vector3f(k.back_project(x, y, z).cast<float>())
-                             : Vector3f::Zero();
+      const Vector3f v = std::isfinite(z) && z > 0 ? Vector3f(k.back_project(x, y, z).cast<float>())
+                                                   : Vector3f::Zero();
       vx[i] = v.x(), vy[i] = v.y(), vz[i] = v.z();
     }
   });

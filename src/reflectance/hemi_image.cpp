@@ -1,10 +1,10 @@
 #include "reflectance/hemi_image.h"
 
+#include <fmt/format.h>
+
 #include <array>
 #include <cmath>
 #include <limits>
-
-#include <fmt/format.h>
 
 #include "core/error.h"
 

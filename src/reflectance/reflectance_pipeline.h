@@ -88,7 +88,8 @@ class ReflectancePipeline {
 
  private:
   void refine_albedo_of_visible();
-  // The depth segmentation's labels at full resolution, in frame_labels_.
+  // The depth segmentation's labels at full resolution: the segmenter's own without halvings,
+  // else frame_labels_ filled from the coarse ones.
   const Image<std::int32_t>& segment_frame(const ImageF& depth_m);
 
   Intrinsics intrinsics_;

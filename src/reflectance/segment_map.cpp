@@ -68,19 +68,21 @@ void SegmentMap::update(ObservationGrid& grid, const std::vector<VisibleVoxel>& 
   slot_of_label_.clear();
   slot_label_.clear();
   voxel_slot_.resize(visible.size());
-  for (std::size_t k = 0, last_label = 0, last_slot = 0; k < visible.size(); ++k) {
+  std::int32_t last_label = 0;  // labels are positive: no voxel matches it at first
+  int last_slot = -1;
+  for (std::size_t k = 0; k < visible.size(); ++k) {
     const std::int32_t label = labels[visible[k].pixel];
     if (label <= 0) {
       voxel_slot_[k] = -1;
       continue;
     }
-    if (std::size_t(label) != last_label) {
+    if (label != last_label) {
       const auto [found, added] = slot_of_label_.try_emplace(label, int(slot_label_.size()));
       if (added) slot_label_.push_back(label);
-      last_label = std::size_t(label);
-      last_slot = std::size_t(found->second);
+      last_label = label;
+      last_slot = found->second;
     }
-    voxel_slot_[k] = int(last_slot);
+    voxel_slot_[k] = last_slot;
   }
   const std::size_t slots = slot_label_.size();
   slot_segment_.assign(slots, 0);  // 0 = the label gets no global id this frame

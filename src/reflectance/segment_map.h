@@ -76,7 +76,7 @@ class SegmentMap {
   // Scratch of update(), kept between frames: a slot per distinct frame label.
   std::unordered_map<int, int> slot_of_label_;
   std::vector<int> slot_label_, slot_segment_, slot_order_;
-  std::vector<int> voxel_slot_;                                  // per visible voxel, -1 = none
+  std::vector<int> voxel_slot_;                                 // per visible voxel, -1 = none
   std::vector<std::vector<std::pair<int, int>>> slot_overlap_;  // (global id, voxels)
 };
 

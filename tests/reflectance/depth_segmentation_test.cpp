@@ -63,8 +63,7 @@ TEST(DepthSegmentation, DepthDiscontinuitiesAndHolesSeparate) {
 
 TEST(DepthSegmentation, ASegmenterReusedAcrossFramesAndSizesMatchesAFreshOne) {
   // One segmenter over frames of two sizes (its buffers kept) gives what a fresh call gives.
-  const ImageF valley =
-      depth_image([](double a, double) { return 2 / (1 + 0.8 * std::abs(a)); });
+  const ImageF valley = depth_image([](double a, double) { return 2 / (1 + 0.8 * std::abs(a)); });
   const ImageF steps = depth_image([](double a, double) { return a < 0 ? 1.5f : 2.5f; });
   const Intrinsics half = kCamera.scaled(0.5);
   ImageF small_image(half.width, half.height, 1);
@@ -73,8 +72,8 @@ TEST(DepthSegmentation, ASegmenterReusedAcrossFramesAndSizesMatchesAFreshOne) {
   const ImageF& small = small_image;
   DepthSegmenter segmenter;
   for (int round = 0; round < 2; ++round)
-    for (const auto& [depth, camera] : {std::pair{&valley, kCamera}, std::pair{&small, half},
-                                        std::pair{&steps, kCamera}}) {
+    for (const auto& [depth, camera] :
+         {std::pair{&valley, kCamera}, std::pair{&small, half}, std::pair{&steps, kCamera}}) {
       const DepthSegmentation& reused = segmenter.segment(*depth, camera);
       const DepthSegmentation fresh = segment_depth(*depth, camera);
       ASSERT_EQ(reused.segment_count, fresh.segment_count);
