@@ -10,11 +10,6 @@
 #include "core/error.h"
 
 namespace glint::reflectance {
-namespace {
-
-constexpr int kHemiLanes = 4;  // one SSE register of floats
-
-}  // namespace
 
 Eigen::Matrix3f local_frame(const Eigen::Vector3f& n) {
   // Duff, Burgess, Christensen, Hery, Kensler, Liani, Villemin: "Building an Orthonormal Basis,
@@ -60,6 +55,7 @@ void make_hemi_image(const Observation* observations, int count, const Eigen::Ve
   // Nearest observation of every pixel, a row at a time in lanes of four columns, without
   // branches (ties go to the first observation, as in a plain scan). The compiler left the plain
   // loop over a row's pixels scalar, with a mispredicted branch per pixel and observation.
+  constexpr int kHemiLanes = 4;  // one SSE register of floats
   using Lanes = float __attribute__((vector_size(kHemiLanes * sizeof(float))));
   using Indices = std::int32_t __attribute__((vector_size(kHemiLanes * sizeof(std::int32_t))));
   constexpr int kMaxChunks = (kMaxHemiImageSize + kHemiLanes - 1) / kHemiLanes;
