@@ -157,6 +157,18 @@ void add_volume_options(CLI::App* command, fusion::VolumeParams& volume) {
   command->add_option("--blocks", volume.block_capacity, "Block pool capacity (10 KiB per block)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  command
+      ->add_option("--far-every", volume.far_fusion_every,
+                   "Fuse far-field blocks (a voxel under --far-voxel-pixels pixels wide) only "
+                   "every N-th frame, staggered; 1 fuses every block every frame")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
+  command
+      ->add_option("--far-voxel-pixels", volume.far_voxel_pixels,
+                   "Far field: where a voxel projects to fewer pixels than this (depth beyond "
+                   "voxel x fx / this)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
 }
 
 void register_fuse_command(CLI::App& app) {

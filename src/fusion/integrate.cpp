@@ -243,11 +243,21 @@ void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const Im
 
   static const BlockKernel fuse_block = block_kernel();
   const std::size_t blocks = visible.indices.size();
+  const Eigen::Vector3f half_block = (step_x + step_y + step_z) * (0.5f * kBlockSide);
+  const float far_depth = float(params.far_field_depth_m(intrinsics.fx));
+  const int far_every = params.far_fusion_every;
+  const int frame = std::max(visible.frame, 0);
   parallel_for(blocks, [&](std::size_t i) {
     const int block = visible.indices[i];
     const int next_block = visible.indices[i + 1 < blocks ? i + 1 : i];
     const Eigen::Vector3f origin =
         rotation * volume.block_origin_m(volume.hash().block(block)).cast<float>() + translation;
+    // A far block's first fusion is never put off: until then it holds no surface for the
+    // reflectance pipeline's observation voxels to find.
+    if (far_every > 1 && (origin + half_block).z() > far_depth && volume.fusions(block) > 0 &&
+        (block + frame) % far_every != 0)
+      return;
+    volume.count_fusion(block);
     float* sdf = volume.sdf_m(block);
     float* weight = volume.weight(block);
     // The weights before this observation, for the colour average.

@@ -5,7 +5,8 @@
 //     allocates the blocks its ray crosses within the truncation band [d - t(d), d + t(d)];
 //     the blocks touched form the frame's visible list.
 //  2. integrate_blocks(): every voxel of every visible block is projected into the depth image
-//     and fused (fusion/tsdf_kernels.h), in parallel over blocks.
+//     and fused (fusion/tsdf_kernels.h), in parallel over blocks; far-field blocks every
+//     VolumeParams::far_fusion_every-th frame.
 #include <vector>
 
 #include "core/camera.h"

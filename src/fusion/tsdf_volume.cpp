@@ -18,6 +18,7 @@ TsdfVolume::TsdfVolume(const VolumeParams& params)
       red_(params.colour ? voxel_pool(params) : PoolArray<float>()),
       green_(params.colour ? voxel_pool(params) : PoolArray<float>()),
       blue_(params.colour ? voxel_pool(params) : PoolArray<float>()),
+      fusions_(make_pool<std::uint8_t>(params.block_capacity, "TSDF volume")),
       last_visible_(new std::atomic<int>[params.block_capacity]) {
   for (std::size_t b = 0; b < params.block_capacity; ++b) last_visible_[b].store(-1);
 }

@@ -9,6 +9,7 @@
 // red, green, blue, weighted mean linear colour (only in volumes that keep colour).
 #include <Eigen/Core>
 #include <atomic>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -66,6 +67,13 @@ class TsdfVolume {
     }
   }
 
+  // How many frames have been fused into a block (saturating at 255). integrate_blocks counts
+  // them; each block is fused by one thread at a time.
+  int fusions(int block) const { return fusions_[block]; }
+  void count_fusion(int block) {
+    if (fusions_[block] < 255) ++fusions_[block];
+  }
+
   // Marks a block seen in frame `frame`; true for the first caller per frame (thread-safe), so
   // the caller appends it to the frame's visible list exactly once.
   bool mark_visible(int block, int frame) {
@@ -80,6 +88,7 @@ class TsdfVolume {
   VolumeParams params_;
   VoxelBlockHash hash_;
   PoolArray<float> sdf_m_, weight_, red_, green_, blue_;
+  PoolArray<std::uint8_t> fusions_;
   std::unique_ptr<std::atomic<int>[]> last_visible_;
 };
 

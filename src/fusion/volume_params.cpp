@@ -17,6 +17,9 @@ void validate(const VolumeParams& params) {
     fail("block_capacity", "must be in [1, 2^30]");
   if (!(params.depth_min_m >= 0) || !(params.depth_max_m > params.depth_min_m))
     fail("depth_max_m", "needs 0 <= depth_min_m < depth_max_m");
+  if (params.far_fusion_every < 1 || params.far_fusion_every > 16)
+    fail("far_fusion_every", "must be in [1, 16]");
+  if (!(params.far_voxel_pixels > 0)) fail("far_voxel_pixels", "must be positive");
 }
 
 }  // namespace glint::fusion

@@ -30,8 +30,18 @@ struct VolumeParams {
   // keeps its colours in the observation grid and turns this off: each new block then zeroes
   // 4 KiB instead of 10, which was 2 ms of its 5 ms block allocation per frame.
   bool colour = true;
+  // Far field: a block whose centre lies where one voxel spans less than `far_voxel_pixels`
+  // pixels (depth > voxel_size_m * fx / far_voxel_pixels) is fused only every
+  // `far_fusion_every`-th frame (after its first fusion), staggered over the blocks so that
+  // each frame fuses an even share. There a pixel's ray passes several voxels, which all read the
+  // same depth sample, and a frame moves the sample little against the last; the 5 mm voxels of a
+  // room's far walls were two thirds of the blocks fused per frame. 1: every block every frame.
+  int far_fusion_every = 1;
+  double far_voxel_pixels = 0.5;
 
   double block_size_m() const { return voxel_size_m * kBlockSide; }
+  // The depth beyond which blocks count as far field, for a camera of focal length fx (pixels).
+  double far_field_depth_m(double fx) const { return voxel_size_m * fx / far_voxel_pixels; }
   double truncation_at(double depth_m) const {
     return truncation_m + truncation_per_depth * depth_m;
   }

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
@@ -119,6 +120,54 @@ TEST(Integrate, MismatchedImagesAndBadParametersAreErrors) {
   VolumeParams bad = plane_params();
   bad.voxel_size_m = 0;
   EXPECT_THROW(TsdfVolume{bad}, Error);
+  bad = plane_params();
+  bad.far_fusion_every = 0;
+  const Error error = test::error_of([&] { TsdfVolume{bad}; });
+  EXPECT_NE(std::string(error.what()).find("far_fusion_every"), std::string::npos);
+}
+
+TEST(Integrate, FarFieldBlocksAreFusedEveryNthFrameStaggered) {
+  // fx = 50 px and 1 cm voxels: a voxel spans half a pixel at 1 m, where the far field starts.
+  // The left half of the image sees a wall at 0.6 m, the right half one at 1.6 m.
+  VolumeParams params = plane_params();
+  params.far_fusion_every = 2;
+  ASSERT_NEAR(params.far_field_depth_m(kCamera.fx), 1.0, 1e-12);
+  TsdfVolume volume(params);
+  VisibleBlocks visible;
+  ImageF depth = wall_depth(0.6);
+  for (int y = 0; y < kCamera.height; ++y)
+    for (int x = kCamera.width / 2; x < kCamera.width; ++x) depth.at(x, y, 0) = 1.6f;
+  const auto fused_times = [&](int block) {  // the largest weight in the block
+    const float* weight = volume.weight(block);
+    return int(*std::max_element(weight, weight + kVoxelsPerBlock));
+  };
+  const auto is_far = [&](int block) {
+    return volume.block_origin_m(volume.hash().block(block)).z() + 0.04 > 1.0;
+  };
+  // The first frame fuses every block, the second every near block and half the far ones.
+  for (int frame = 0; frame < 2; ++frame)
+    integrate(volume, depth, ImageF(), kCamera, Pose::Identity(), visible);
+  int far_twice = 0, far_once = 0, near = 0;
+  for (const int block : visible.indices) {
+    if (fused_times(block) == 0) continue;  // only the band's outer voxels: never reached
+    if (!is_far(block)) {
+      EXPECT_EQ(fused_times(block), 2);
+      ++near;
+      continue;
+    }
+    ASSERT_GE(fused_times(block), 1);
+    (fused_times(block) == 2 ? far_twice : far_once) += 1;
+  }
+  ASSERT_GT(near, 0);
+  EXPECT_GT(far_twice, 0) << "half the far blocks in each frame";
+  EXPECT_GT(far_once, 0);
+  // The third frame fuses the other half.
+  integrate(volume, depth, ImageF(), kCamera, Pose::Identity(), visible);
+  for (const int block : visible.indices) {
+    if (fused_times(block) == 0) continue;
+    EXPECT_EQ(fused_times(block), is_far(block) ? 2 : 3) << "block " << block;
+    EXPECT_EQ(volume.fusions(block), is_far(block) ? 2 : 3);
+  }
 }
 
 TEST(Integrate, ZeroDepthIsNoMeasurement) {
