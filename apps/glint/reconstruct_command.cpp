@@ -238,6 +238,7 @@ void run_reconstruct(ReconstructOptions options) {
         {{"obs_voxel_m", options.params.observations.voxel_size_m},
          {"voxel_m", options.params.geometry.volume.voxel_size_m},
          {"observations_per_voxel", options.params.observations.observations_per_voxel},
+         {"obs_spacing_deg", options.params.observations.min_observation_spacing_deg},
          {"albedo_average", reflectance::albedo_average_name(options.params.albedo_average)},
          {"albedo_min_light_cosine", options.params.albedo_min_light_cosine},
          {"specular", specular_name(options.params.specular)},
@@ -288,6 +289,12 @@ void register_reconstruct_command(CLI::App& app) {
                    "Observation voxel pool (about 1.1 KB each, committed as used); default 2^20 "
                    "at 2 cm, 2 x (0.02 / obs-voxel)^2 times that below")
       ->check(CLI::PositiveNumber);
+  command
+      ->add_option("--obs-spacing", params.observations.min_observation_spacing_deg,
+                   "Degrees: an observation this close in direction to its voxel's newest stored "
+                   "one is not stored (0 stores every one)")
+      ->check(CLI::Range(0.0, 89.9))
+      ->capture_default_str();
   add_volume_options(command, params.geometry.volume);
   command->add_flag("--gt-poses", params.geometry.use_ground_truth_poses,
                     "Use the dataset's ground-truth poses instead of tracking");

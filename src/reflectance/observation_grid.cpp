@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <optional>
 #include <string>
 
@@ -94,6 +95,7 @@ void ObservationGrid::prefetch_voxel_state(int block) const {
   prefetch_lines(normal_.get() + first, voxels * sizeof(Eigen::Vector3f));
   prefetch_lines(observation_count_.get() + first, voxels * sizeof(std::uint8_t));
   prefetch_lines(observation_set_.get() + first, voxels * sizeof(std::int32_t));
+  prefetch_lines(newest_direction_.get() + first, voxels * sizeof(Eigen::Vector3f));
 }
 
 Eigen::Vector3i ObservationGrid::geometry_block(int block, float geometry_blocks_per_block) const {
@@ -131,11 +133,14 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
     throw Error("observation grid", "settled_refresh_doublings", "must be in 0..8");
   if (!(params.settled_shift >= 0))
     throw Error("observation grid", "settled_shift", "must be >= 0");
+  if (!(params.min_observation_spacing_deg >= 0 && params.min_observation_spacing_deg < 90))
+    throw Error("observation grid", "min_observation_spacing_deg", "must be in [0, 90)");
   const std::size_t voxels = hash_.capacity() * voxels_per_block_;
   observations_ = voxel_pool<Observation>(voxels * params.observations_per_voxel);
   nearest_ = voxel_pool<NearestObservation>(voxels * params.observations_per_voxel);
   observation_set_ = voxel_pool<std::int32_t>(voxels);
   observation_count_ = voxel_pool<std::uint8_t>(voxels);
+  newest_direction_ = voxel_pool<Eigen::Vector3f>(voxels);
   position_ = voxel_pool<Eigen::Vector3f>(voxels);
   normal_ = voxel_pool<Eigen::Vector3f>(voxels);
   refined_kd_ = voxel_pool<Eigen::Vector3f>(voxels);
@@ -316,6 +321,10 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
   const Eigen::Vector3f camera_centre = camera_to_world.translation().cast<float>();
   const float inverse_exposure = 1.0f / exposure;
   const int capacity = params_.observations_per_voxel;
+  const float spacing_cosine =
+      params_.min_observation_spacing_deg > 0
+          ? float(std::cos(params_.min_observation_spacing_deg * std::numbers::pi / 180))
+          : 2.0f;  // no dot product of unit vectors exceeds it
   const int width = depth_m.width(), height = depth_m.height();
 
   // One slot per voxel of the frame's blocks; -1 = not observed.
@@ -356,6 +365,7 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
         observation_count_[v] =
             std::uint8_t(insert_observation(observations_.get() + first, nearest_.get() + first,
                                             observation_count_[v], capacity, observation));
+        newest_direction_[v] = voxel.direction;
         visible_[voxel.visible_index] = {v, voxel.y * width + voxel.x};
       }
       pending = 0;
@@ -390,6 +400,10 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
         if (!(measured > 0) || std::fabs(measured - q.z()) > tolerance) continue;
         const Eigen::Vector3f direction = (camera_centre - position_[v]).normalized();
         if (normal_[v].dot(direction) < float(params_.min_view_cosine)) continue;
+        if (observation_count_[v] > 0 && direction.dot(newest_direction_[v]) > spacing_cosine) {
+          visible_[int(slot) * voxels_per_block_ + local] = {v, y * width + x};
+          continue;
+        }
         prefetch_observations(v, true);
         seen[pending++] = {v, int(slot) * voxels_per_block_ + local, x, y, direction};
       }

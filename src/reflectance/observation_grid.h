@@ -53,7 +53,15 @@ struct ObservationGridParams {
   double depth_tolerance_m = 0.01;    // |measured - voxel depth| allowed, plus ...
   double depth_tolerance_sigmas = 3;  // ... this many Kinect sigma(z) (render/sensor.h)
   double min_view_cosine = 0.1;       // normal . direction of an accepted observation
-  int geometry_refresh_frames = 8;    // surface point / normal recomputed this often
+  // An observation seen within this angle of the voxel's newest stored one is not stored (the
+  // voxel still counts as seen in the frame). Along a smooth camera path successive frames see
+  // a voxel from nearly the same direction (office: about 0.7 degrees per frame at 4.5 m), and
+  // such a pair adds nothing to the hemisphere coverage that m = 30 observations approximate:
+  // once the voxel is full it is the first pair the replacement rule merges. 0 stores every
+  // observation, as the paper does and as the HemiCNN's training data were collected
+  // (hemi_extraction.h); the reflectance pipeline uses 1 degree (ReflectanceParams).
+  double min_observation_spacing_deg = 0;
+  int geometry_refresh_frames = 8;  // surface point / normal recomputed this often
   // The normal as the least-squares plane through the surface points of the voxel and its (up
   // to 26) neighbours, instead of the TSDF gradient at the point. The gradient of a TSDF fused
   // from millimetre-quantised depth tilts by 1-3 degrees on a flat face, which puts a sharp
@@ -191,6 +199,7 @@ class ObservationGrid {
   PoolArray<std::int32_t> observation_set_;  // 1 + its set of slots, 0 = none yet
   std::atomic<std::int32_t> observation_sets_used_{0};
   PoolArray<std::uint8_t> observation_count_;
+  PoolArray<Eigen::Vector3f> newest_direction_;  // of the latest stored observation
   PoolArray<Eigen::Vector3f> position_, normal_, refined_kd_;
   PoolArray<int> next_refresh_frame_;        // frame of the next surface refresh
   PoolArray<std::uint8_t> surface_misses_;   // refreshes in a row that found no surface

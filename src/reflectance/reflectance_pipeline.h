@@ -32,7 +32,10 @@ struct ReflectanceParams {
   fusion::FusionParams geometry{
       .volume = {.truncation_per_depth = 0.005, .depth_max_m = 6.0, .colour = false},
       .tracking = {}};
-  ObservationGridParams observations;
+  // Observations 1 degree apart at least (ObservationGridParams::min_observation_spacing_deg;
+  // chosen on cubes, where 1 degree changed no metric beyond run-to-run spread and 2 degrees
+  // cost 0.3 dB refined RGB; office held out: +0.8 dB, observation stage -3.6 ms per frame).
+  ObservationGridParams observations{.min_observation_spacing_deg = 1.0};
   DepthSegmentationParams segmentation;  // min_segment_px at full resolution
   // The depth segmentation runs on the depth image halved this many times (KinectFusion's
   // edge-preserving block average, fusion/depth_maps.h): a quarter of the pixels per level,

@@ -104,6 +104,42 @@ TEST(ObservationGrid, ObservationsAccumulateUpToTheCapacity) {
   EXPECT_GT(full, 20);
 }
 
+TEST(ObservationGrid, ObservationsCloserThanTheSpacingToTheNewestAreNotStored) {
+  // min_observation_spacing_deg 1: the camera creeps 1 mm per frame (0.06 degrees at 1 m),
+  // which stores nothing new although every voxel stays seen, then jumps 3 cm (1.7 degrees).
+  fusion::TsdfVolume geometry(geometry_params());
+  fusion::VisibleBlocks blocks;
+  Wall wall;
+  fusion::integrate(geometry, wall.depth, wall.colour, kCamera, Pose::Identity(), blocks);
+  ObservationGridParams params = grid_params();
+  params.min_observation_spacing_deg = 1;
+  ObservationGrid grid(params);
+  const auto pose_at = [](double x_m) {
+    Pose pose = Pose::Identity();
+    pose.translation() = Eigen::Vector3d(x_m, 0, 0);
+    return pose;
+  };
+  const std::size_t first_seen =
+      grid.collect(wall.depth, wall.colour, kCamera, pose_at(0), 1.0f, geometry, 0).size();
+  ASSERT_GT(first_seen, 50u);
+  const auto max_count = [&] {
+    int most = 0;
+    for (const VisibleVoxel& seen : grid.visible())
+      most = std::max(most, grid.observation_count(seen.voxel));
+    return most;
+  };
+  for (int frame = 1; frame <= 5; ++frame) {
+    const auto& visible = grid.collect(wall.depth, wall.colour, kCamera, pose_at(0.001 * frame),
+                                       1.0f, geometry, frame);
+    EXPECT_GE(visible.size(), first_seen - 10) << "frame " << frame << ": still seen";
+    EXPECT_EQ(max_count(), 1) << "frame " << frame;
+  }
+  grid.collect(wall.depth, wall.colour, kCamera, pose_at(0.035), 1.0f, geometry, 6);
+  EXPECT_EQ(max_count(), 2);
+  params.min_observation_spacing_deg = 90;
+  EXPECT_THROW(ObservationGrid{params}, Error);
+}
+
 TEST(ObservationGrid, VoxelsWithoutSurfaceAreRetriedEverLessOften) {
   // Frames 0-8 see the wall before any geometry is fused: its voxels find no surface at frame 0
   // and at their first retry (frame 8); the second retry waits twice as long (frame 24).
