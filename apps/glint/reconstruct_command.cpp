@@ -363,8 +363,16 @@ void register_reconstruct_command(CLI::App& app) {
           "where a sharp highlight needs the normal to a fraction of a degree)")
       ->check(CLI::IsMember({kGradientNormals, kPlaneNormals}))
       ->default_str(normals_name(params.observations));
-  command->add_option("--seed", params.specular.seed, "Seed of the voxel sampling")
-      ->capture_default_str();
+  command
+      ->add_option_function<std::uint64_t>(
+          "--seed",
+          [options](std::uint64_t seed) {
+            options->params.specular.seed = seed;
+            options->params.segments.seed = seed;
+          },
+          "Seed of the voxel sampling (each segment's voxel reservoir and each frame's draw "
+          "from it)")
+      ->default_str(std::to_string(params.specular.seed));
   command->add_option("--report", options->report,
                       "JSON report: parameters, per-stage timings, materials, evaluation");
   command->footer(

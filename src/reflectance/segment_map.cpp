@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <numeric>
 
+#include "core/error.h"
+
 namespace glint::reflectance {
 namespace {
 
@@ -10,6 +12,10 @@ namespace {
 constexpr std::size_t kPrefetchDistance = 16;
 
 }  // namespace
+
+SegmentMap::SegmentMap(const SegmentMapParams& params) : params_(params), random_(params.seed) {
+  if (params.ring_capacity < 1) throw Error("segment map", "ring_capacity", "must be >= 1");
+}
 
 SegmentMap::Ring& SegmentMap::ring(int segment) {
   if (segment >= int(segments_.size())) segments_.resize(segment + 1);
@@ -31,12 +37,20 @@ void SegmentMap::assign(ObservationGrid& grid, int voxel, int segment) {
   current = segment;
   confidence = 1;
   Ring& members = ring(segment);
+  ++members.joined;
+  offer(members, voxel);
+}
+
+void SegmentMap::offer(Ring& members, int voxel) {
+  // Vitter's algorithm R: after n offers each of them is in the buffer with probability
+  // capacity / n.
   if (int(members.voxels.size()) < params_.ring_capacity) {
     members.voxels.push_back(voxel);
-  } else {
-    members.voxels[members.next] = voxel;
-    members.next = (members.next + 1) % members.voxels.size();
+    return;
   }
+  const std::uint64_t slot =
+      std::uniform_int_distribution<std::uint64_t>(0, members.joined - 1)(random_);
+  if (slot < members.voxels.size()) members.voxels[slot] = voxel;
 }
 
 int SegmentMap::resolve(int segment) const {
@@ -50,10 +64,14 @@ void SegmentMap::merge(ObservationGrid& grid, int kept, int gone) {
     if (grid.segment(v) == gone) grid.segment(v) = kept;
   Ring& from = ring(gone);
   Ring& into = ring(kept);
-  for (int voxel : from.voxels) {
-    if (int(into.voxels.size()) >= params_.ring_capacity) break;
-    into.voxels.push_back(voxel);
+  // `from`'s entries join `into`'s stream as its next `from.joined` members, each standing for
+  // an equal share of them (exact while `from` had not overflowed, approximate after).
+  const std::uint64_t base = into.joined, entries = from.voxels.size();
+  for (std::uint64_t k = 0; k < entries; ++k) {
+    into.joined = base + from.joined * (k + 1) / entries;
+    offer(into, from.voxels[k]);
   }
+  into.joined = base + from.joined;
   from = Ring{};
   if (gone >= int(merged_into_.size())) merged_into_.resize(gone + 1, 0);
   merged_into_[gone] = kept;

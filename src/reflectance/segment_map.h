@@ -10,9 +10,13 @@
 //    merged into the other (its voxels relabelled, its ring appended).
 //  - A voxel's id changes only after repeated disagreement: agreeing frames raise its
 //    confidence (up to max_confidence), disagreeing ones lower it, and at 0 it switches.
-// Each global segment owns a fixed-size ring buffer of voxel references that new members are
-// written into (the oldest entry is overwritten); the specular estimation samples voxels of a
-// segment from it. Entries may be stale (the voxel changed segment): samplers check.
+// Each global segment owns a fixed-size buffer of voxel references (the paper's ring buffer),
+// from which the specular estimation samples its voxels. It is kept a uniform random sample of
+// every voxel that joined the segment (reservoir sampling): overwriting the oldest entry, as a
+// ring would, left it holding only the newest members whenever a segment grew by more than
+// its capacity per frame (cubes' floor at 1 cm: 4,000-8,000 new voxels per frame), whose
+// single observations no sample can use. Entries may be stale (the voxel changed segment):
+// samplers check.
 // In ground-truth mode the frame labels are already global ids (the synthetic gt/segment
 // images) and are written to the voxels directly.
 #include <cstdint>
@@ -28,6 +32,7 @@ namespace glint::reflectance {
 
 struct SegmentMapParams {
   int ring_capacity = 4096;  // voxel references per segment
+  std::uint64_t seed = 1;    // of the buffers' reservoir sampling
   double min_overlap = 0.3;
   int min_new_segment_voxels = 20;
   int max_confidence = 8;
@@ -36,7 +41,7 @@ struct SegmentMapParams {
 
 class SegmentMap {
  public:
-  explicit SegmentMap(const SegmentMapParams& params = {}) : params_(params) {}
+  explicit SegmentMap(const SegmentMapParams& params = {});
 
   // Labels the voxels observed in this frame. frame_labels: one value per pixel (0 = none);
   // labels_are_global: ground-truth ids instead of per-frame labels.
@@ -62,13 +67,17 @@ class SegmentMap {
  private:
   struct Ring {
     std::vector<int> voxels;
-    std::size_t next = 0;
+    std::uint64_t joined = 0;  // voxels that ever joined the segment (the reservoir's stream)
   };
   Ring& ring(int segment);
+  // Offers `voxel`, the `joined`-th member, to the reservoir: kept with probability
+  // capacity / joined, in place of a random entry.
+  void offer(Ring& members, int voxel);
   void assign(ObservationGrid& grid, int voxel, int segment);
   void merge(ObservationGrid& grid, int kept, int gone);
 
   SegmentMapParams params_;
+  std::mt19937_64 random_;
   std::vector<Ring> segments_{1};  // index = global id; 0 unused
   std::vector<int> frame_segments_;
   std::vector<int> merged_into_;  // by id: the id it was merged into, 0 = none

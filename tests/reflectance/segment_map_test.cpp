@@ -4,10 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 #include <random>
 #include <set>
 
+#include "core/error.h"
 #include "fusion/integrate.h"
 #include "reflectance/depth_segmentation.h"
 
@@ -140,6 +142,46 @@ TEST(SegmentMap, GroundTruthIdsAreUsedAsTheyAre) {
   for (const VisibleVoxel& seen : visible)
     EXPECT_EQ(scene.grid.segment(seen.voxel),
               wall_of(scene.grid.position(seen.voxel)) == 1 ? 7 : 9);
+}
+
+// A segment that grows by more than its buffer holds in one frame: the buffer stays a uniform
+// sample of all its members, so the well-observed early ones can still be drawn (a ring that
+// overwrote its oldest entries held only the newest voxels, each seen once).
+TEST(SegmentMap, BufferStaysAUniformSampleOfASegmentGrowingFasterThanItHolds) {
+  Scene scene;
+  constexpr int kCapacity = 256;
+  SegmentMap segments(SegmentMapParams{.ring_capacity = kCapacity});
+  std::set<int> early;  // joined in the first three frames (camera still)
+  std::set<int> late;   // joined in the last one (camera moved 0.6 m)
+  for (int index = 0; index < 4; ++index) {
+    ImageF depth;
+    const auto& visible = scene.frame(index, index < 3 ? 0.0 : 0.6, depth);
+    const Image<std::int32_t> ids(kCamera.width, kCamera.height, 1, 7);  // one segment
+    for (const VisibleVoxel& seen : visible)
+      if (scene.grid.segment(seen.voxel) == 0) (index < 3 ? early : late).insert(seen.voxel);
+    segments.update(scene.grid, visible, ids, true);
+  }
+  ASSERT_GT(early.size(), std::size_t(2 * kCapacity));
+  ASSERT_GT(late.size(), std::size_t(kCapacity));
+  EXPECT_EQ(segments.ring_size(7), kCapacity);
+
+  std::mt19937_64 random(5);
+  std::vector<int> sampled(kCapacity);
+  // Every entry, each checked once: the buffer's composition.
+  const int count = segments.sample(scene.grid, 7, kCapacity, 1, random, sampled.data());
+  ASSERT_EQ(count, kCapacity);
+  const double early_share =
+      double(std::count_if(sampled.begin(), sampled.end(), [&](int v) { return early.count(v); })) /
+      count;
+  const double expected = double(early.size()) / double(early.size() + late.size());
+  // Binomial spread of 256 draws: a standard deviation under 0.032.
+  EXPECT_NEAR(early_share, expected, 0.12);
+  // The early voxels were observed in three frames: a sample needing three finds them.
+  EXPECT_EQ(segments.sample(scene.grid, 7, 25, 3, random, sampled.data()), 25);
+}
+
+TEST(SegmentMap, RejectsAnEmptyBuffer) {
+  EXPECT_THROW(SegmentMap(SegmentMapParams{.ring_capacity = 0}), Error);
 }
 
 }  // namespace
