@@ -14,15 +14,16 @@ constexpr std::size_t kPrefetchDistance = 16;
 }  // namespace
 
 SegmentMap::SegmentMap(const SegmentMapParams& params) : params_(params), random_(params.seed) {
-  if (params.ring_capacity < 1) throw Error("segment map", "ring_capacity", "must be >= 1");
+  if (params.reservoir_capacity < 1)
+    throw Error("segment map", "reservoir_capacity", "must be >= 1");
 }
 
-SegmentMap::Ring& SegmentMap::ring(int segment) {
+SegmentMap::Reservoir& SegmentMap::reservoir(int segment) {
   if (segment >= int(segments_.size())) segments_.resize(segment + 1);
   return segments_[segment];
 }
 
-int SegmentMap::ring_size(int segment) const {
+int SegmentMap::reservoir_size(int segment) const {
   return segment > 0 && segment < int(segments_.size()) ? int(segments_[segment].voxels.size()) : 0;
 }
 
@@ -36,15 +37,15 @@ void SegmentMap::assign(ObservationGrid& grid, int voxel, int segment) {
   if (current != 0 && --confidence > 0) return;
   current = segment;
   confidence = 1;
-  Ring& members = ring(segment);
+  Reservoir& members = reservoir(segment);
   ++members.joined;
   offer(members, voxel);
 }
 
-void SegmentMap::offer(Ring& members, int voxel) {
+void SegmentMap::offer(Reservoir& members, int voxel) {
   // Vitter's algorithm R: after n offers each of them is in the buffer with probability
   // capacity / n.
-  if (int(members.voxels.size()) < params_.ring_capacity) {
+  if (int(members.voxels.size()) < params_.reservoir_capacity) {
     members.voxels.push_back(voxel);
     return;
   }
@@ -62,8 +63,8 @@ int SegmentMap::resolve(int segment) const {
 void SegmentMap::merge(ObservationGrid& grid, int kept, int gone) {
   for (int v = 0; v < int(grid.voxel_count()); ++v)
     if (grid.segment(v) == gone) grid.segment(v) = kept;
-  Ring& from = ring(gone);
-  Ring& into = ring(kept);
+  Reservoir& from = reservoir(gone);
+  Reservoir& into = reservoir(kept);
   // `from`'s entries join `into`'s stream as its next `from.joined` members, each standing for
   // an equal share of them (exact while `from` had not overflowed, approximate after).
   const std::uint64_t base = into.joined, entries = from.voxels.size();
@@ -71,8 +72,7 @@ void SegmentMap::merge(ObservationGrid& grid, int kept, int gone) {
     into.joined = base + from.joined * (k + 1) / entries;
     offer(into, from.voxels[k]);
   }
-  into.joined = base + from.joined;
-  from = Ring{};
+  from = Reservoir{};
   if (gone >= int(merged_into_.size())) merged_into_.resize(gone + 1, 0);
   merged_into_[gone] = kept;
   ++merges_;
@@ -181,7 +181,7 @@ int SegmentMap::sample(const ObservationGrid& grid, int segment, int count, int 
   if (segment <= 0 || segment >= int(segments_.size())) return 0;
   const std::vector<int>& members = segments_[segment].voxels;
   if (members.empty()) return 0;
-  // One pass over the ring in a random order (a random start and a step coprime to its size):
+  // One pass over the reservoir in a random order (a random start and a step coprime to its size):
   // every member is looked at once, so rarely observed voxels cannot starve the sample.
   const std::size_t n = members.size();
   std::uniform_int_distribution<std::size_t> pick(0, n - 1);

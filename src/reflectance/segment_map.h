@@ -7,10 +7,10 @@
 //    voxels, it starts a new global segment.
 //  - When one frame segment covers two global segments, each with at least merge_fraction of
 //    its voxels, they are one surface seen in pieces before: the one covering fewer of them is
-//    merged into the other (its voxels relabelled, its ring appended).
+//    merged into the other (its voxels relabelled, its reservoir offered to the other).
 //  - A voxel's id changes only after repeated disagreement: agreeing frames raise its
 //    confidence (up to max_confidence), disagreeing ones lower it, and at 0 it switches.
-// Each global segment owns a fixed-size buffer of voxel references (the paper's ring buffer),
+// Each global segment owns a fixed-size reservoir of voxel references (the paper's ring buffer),
 // from which the specular estimation samples its voxels. It is kept a uniform random sample of
 // every voxel that joined the segment (reservoir sampling): overwriting the oldest entry, as a
 // ring would, left it holding only the newest members whenever a segment grew by more than
@@ -31,8 +31,8 @@
 namespace glint::reflectance {
 
 struct SegmentMapParams {
-  int ring_capacity = 4096;  // voxel references per segment
-  std::uint64_t seed = 1;    // of the buffers' reservoir sampling
+  int reservoir_capacity = 4096;  // voxel references per segment
+  std::uint64_t seed = 1;         // of the reservoirs' sampling
   double min_overlap = 0.3;
   int min_new_segment_voxels = 20;
   int max_confidence = 8;
@@ -55,30 +55,30 @@ class SegmentMap {
   // The segment a (possibly merged) id lives on as.
   int resolve(int segment) const;
   int merges() const { return merges_; }
-  // Voxel references currently in the segment's ring (stale ones included).
-  int ring_size(int segment) const;
+  // Voxel references currently in the segment's reservoir (stale ones included).
+  int reservoir_size(int segment) const;
 
   // Writes up to `count` distinct voxels of `segment` that still carry its id and have at
-  // least `min_observations` observations, drawn at random from its ring (each member is
-  // considered at most once, so at most ring_capacity checks); returns how many.
+  // least `min_observations` observations, drawn at random from its reservoir (each member is
+  // considered at most once, so at most reservoir_capacity checks); returns how many.
   int sample(const ObservationGrid& grid, int segment, int count, int min_observations,
              std::mt19937_64& random, int* voxels) const;
 
  private:
-  struct Ring {
+  struct Reservoir {
     std::vector<int> voxels;
     std::uint64_t joined = 0;  // voxels that ever joined the segment (the reservoir's stream)
   };
-  Ring& ring(int segment);
+  Reservoir& reservoir(int segment);
   // Offers `voxel`, the `joined`-th member, to the reservoir: kept with probability
   // capacity / joined, in place of a random entry.
-  void offer(Ring& members, int voxel);
+  void offer(Reservoir& members, int voxel);
   void assign(ObservationGrid& grid, int voxel, int segment);
   void merge(ObservationGrid& grid, int kept, int gone);
 
   SegmentMapParams params_;
   std::mt19937_64 random_;
-  std::vector<Ring> segments_{1};  // index = global id; 0 unused
+  std::vector<Reservoir> segments_{1};  // index = global id; 0 unused
   std::vector<int> frame_segments_;
   std::vector<int> merged_into_;  // by id: the id it was merged into, 0 = none
   int merges_ = 0;

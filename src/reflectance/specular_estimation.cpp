@@ -51,9 +51,9 @@ void SpecularEstimator::update(const ObservationGrid& grid, const SegmentMap& se
     const int sampled = segment_map.sample(grid, segments[i], count, params_.min_observations,
                                            random, voxels.data());
     if (sampled < count) {
-      log().debug("frame {}: segment {} has {} of {} voxels with {} observations (ring {})", frame,
-                  segments[i], sampled, count, params_.min_observations,
-                  segment_map.ring_size(segments[i]));
+      log().debug("frame {}: segment {} has {} of {} voxels with {} observations (reservoir {})",
+                  frame, segments[i], sampled, count, params_.min_observations,
+                  segment_map.reservoir_size(segments[i]));
       return;
     }
     std::vector<float> images(std::size_t(count) * image_floats);

@@ -150,7 +150,7 @@ TEST(SegmentMap, GroundTruthIdsAreUsedAsTheyAre) {
 TEST(SegmentMap, BufferStaysAUniformSampleOfASegmentGrowingFasterThanItHolds) {
   Scene scene;
   constexpr int kCapacity = 256;
-  SegmentMap segments(SegmentMapParams{.ring_capacity = kCapacity});
+  SegmentMap segments(SegmentMapParams{.reservoir_capacity = kCapacity});
   std::set<int> early;  // joined in the first three frames (camera still)
   std::set<int> late;   // joined in the last one (camera moved 0.6 m)
   for (int index = 0; index < 4; ++index) {
@@ -163,7 +163,7 @@ TEST(SegmentMap, BufferStaysAUniformSampleOfASegmentGrowingFasterThanItHolds) {
   }
   ASSERT_GT(early.size(), std::size_t(2 * kCapacity));
   ASSERT_GT(late.size(), std::size_t(kCapacity));
-  EXPECT_EQ(segments.ring_size(7), kCapacity);
+  EXPECT_EQ(segments.reservoir_size(7), kCapacity);
 
   std::mt19937_64 random(5);
   std::vector<int> sampled(kCapacity);
@@ -181,7 +181,7 @@ TEST(SegmentMap, BufferStaysAUniformSampleOfASegmentGrowingFasterThanItHolds) {
 }
 
 TEST(SegmentMap, RejectsAnEmptyBuffer) {
-  EXPECT_THROW(SegmentMap(SegmentMapParams{.ring_capacity = 0}), Error);
+  EXPECT_THROW(SegmentMap(SegmentMapParams{.reservoir_capacity = 0}), Error);
 }
 
 }  // namespace
