@@ -239,6 +239,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"voxel_m", options.params.geometry.volume.voxel_size_m},
          {"observations_per_voxel", options.params.observations.observations_per_voxel},
          {"obs_spacing_deg", options.params.observations.min_observation_spacing_deg},
+         {"obs_spacing_frames", options.params.observations.spacing_max_frames},
          {"albedo_average", reflectance::albedo_average_name(options.params.albedo_average)},
          {"albedo_min_light_cosine", options.params.albedo_min_light_cosine},
          {"specular", specular_name(options.params.specular)},
@@ -292,8 +293,16 @@ void register_reconstruct_command(CLI::App& app) {
   command
       ->add_option("--obs-spacing", params.observations.min_observation_spacing_deg,
                    "Degrees: an observation this close in direction to its voxel's newest stored "
-                   "one is not stored (0 stores every one)")
+                   "one is not stored, unless that is --obs-spacing-frames old (0 stores every "
+                   "one)")
       ->check(CLI::Range(0.0, 89.9))
+      ->capture_default_str();
+  command
+      ->add_option("--obs-spacing-frames", params.observations.spacing_max_frames,
+                   "Frames: an observation is stored however close to its voxel's newest one "
+                   "once that is this old, so a slowly moving camera still collects enough for "
+                   "the specular stage (0: never)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   add_volume_options(command, params.geometry.volume);
   command->add_flag("--gt-poses", params.geometry.use_ground_truth_poses,

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -95,7 +96,7 @@ void ObservationGrid::prefetch_voxel_state(int block) const {
   prefetch_lines(normal_.get() + first, voxels * sizeof(Eigen::Vector3f));
   prefetch_lines(observation_count_.get() + first, voxels * sizeof(std::uint8_t));
   prefetch_lines(observation_set_.get() + first, voxels * sizeof(std::int32_t));
-  prefetch_lines(newest_direction_.get() + first, voxels * sizeof(Eigen::Vector3f));
+  prefetch_lines(newest_.get() + first, voxels * sizeof(NewestObservation));
 }
 
 Eigen::Vector3i ObservationGrid::geometry_block(int block, float geometry_blocks_per_block) const {
@@ -135,12 +136,14 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
     throw Error("observation grid", "settled_shift", "must be >= 0");
   if (!(params.min_observation_spacing_deg >= 0 && params.min_observation_spacing_deg < 90))
     throw Error("observation grid", "min_observation_spacing_deg", "must be in [0, 90)");
+  if (params.spacing_max_frames < 0)
+    throw Error("observation grid", "spacing_max_frames", "must be >= 0");
   const std::size_t voxels = hash_.capacity() * voxels_per_block_;
   observations_ = voxel_pool<Observation>(voxels * params.observations_per_voxel);
   nearest_ = voxel_pool<NearestObservation>(voxels * params.observations_per_voxel);
   observation_set_ = voxel_pool<std::int32_t>(voxels);
   observation_count_ = voxel_pool<std::uint8_t>(voxels);
-  newest_direction_ = voxel_pool<Eigen::Vector3f>(voxels);
+  newest_ = voxel_pool<NewestObservation>(voxels);
   position_ = voxel_pool<Eigen::Vector3f>(voxels);
   normal_ = voxel_pool<Eigen::Vector3f>(voxels);
   refined_kd_ = voxel_pool<Eigen::Vector3f>(voxels);
@@ -325,6 +328,8 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
       params_.min_observation_spacing_deg > 0
           ? float(std::cos(params_.min_observation_spacing_deg * std::numbers::pi / 180))
           : 2.0f;  // no dot product of unit vectors exceeds it
+  const int spacing_max_frames =
+      params_.spacing_max_frames > 0 ? params_.spacing_max_frames : std::numeric_limits<int>::max();
   const int width = depth_m.width(), height = depth_m.height();
 
   // One slot per voxel of the frame's blocks; -1 = not observed.
@@ -365,7 +370,7 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
         observation_count_[v] =
             std::uint8_t(insert_observation(observations_.get() + first, nearest_.get() + first,
                                             observation_count_[v], capacity, observation));
-        newest_direction_[v] = voxel.direction;
+        newest_[v] = {voxel.direction, frame};
         visible_[voxel.visible_index] = {v, voxel.y * width + voxel.x};
       }
       pending = 0;
@@ -400,7 +405,8 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
         if (!(measured > 0) || std::fabs(measured - q.z()) > tolerance) continue;
         const Eigen::Vector3f direction = (camera_centre - position_[v]).normalized();
         if (normal_[v].dot(direction) < float(params_.min_view_cosine)) continue;
-        if (observation_count_[v] > 0 && direction.dot(newest_direction_[v]) > spacing_cosine) {
+        if (observation_count_[v] > 0 && direction.dot(newest_[v].direction) > spacing_cosine &&
+            frame - newest_[v].frame < spacing_max_frames) {
           visible_[int(slot) * voxels_per_block_ + local] = {v, y * width + x};
           continue;
         }

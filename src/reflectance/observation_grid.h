@@ -61,6 +61,11 @@ struct ObservationGridParams {
   // observation, as the paper does and as the HemiCNN's training data were collected
   // (hemi_extraction.h); the reflectance pipeline uses 1 degree (ReflectanceParams).
   double min_observation_spacing_deg = 0;
+  // An observation is stored however close to the newest stored one once that is this many
+  // frames old (0: never). A slow hand-held camera would otherwise leave most voxels short of
+  // the specular stage's SpecularParams::min_observations (5) and their segments without a
+  // material; a camera sweeping a voxel by the spacing within this many frames is unaffected.
+  int spacing_max_frames = 0;
   int geometry_refresh_frames = 8;  // surface point / normal recomputed this often
   // The normal as the least-squares plane through the surface points of the voxel and its (up
   // to 26) neighbours, instead of the TSDF gradient at the point. The gradient of a TSDF fused
@@ -199,7 +204,11 @@ class ObservationGrid {
   PoolArray<std::int32_t> observation_set_;  // 1 + its set of slots, 0 = none yet
   std::atomic<std::int32_t> observation_sets_used_{0};
   PoolArray<std::uint8_t> observation_count_;
-  PoolArray<Eigen::Vector3f> newest_direction_;  // of the latest stored observation
+  struct NewestObservation {
+    Eigen::Vector3f direction;
+    std::int32_t frame;
+  };
+  PoolArray<NewestObservation> newest_;  // the latest stored observation's
   PoolArray<Eigen::Vector3f> position_, normal_, refined_kd_;
   PoolArray<int> next_refresh_frame_;        // frame of the next surface refresh
   PoolArray<std::uint8_t> surface_misses_;   // refreshes in a row that found no surface

@@ -140,6 +140,33 @@ TEST(ObservationGrid, ObservationsCloserThanTheSpacingToTheNewestAreNotStored) {
   EXPECT_THROW(ObservationGrid{params}, Error);
 }
 
+TEST(ObservationGrid, AnObservationIsStoredHoweverCloseOnceTheNewestIsOldEnough) {
+  // spacing_max_frames 3: the creeping camera of the test above stores a voxel's first view,
+  // then one every third frame, and its jump at once.
+  fusion::TsdfVolume geometry(geometry_params());
+  fusion::VisibleBlocks blocks;
+  Wall wall;
+  fusion::integrate(geometry, wall.depth, wall.colour, kCamera, Pose::Identity(), blocks);
+  ObservationGridParams params = grid_params();
+  params.min_observation_spacing_deg = 1;
+  params.spacing_max_frames = 3;
+  ObservationGrid grid(params);
+  const auto most_after = [&](double x_m, int frame) {
+    Pose pose = Pose::Identity();
+    pose.translation() = Eigen::Vector3d(x_m, 0, 0);
+    int most = 0;
+    for (const VisibleVoxel& seen :
+         grid.collect(wall.depth, wall.colour, kCamera, pose, 1.0f, geometry, frame))
+      most = std::max(most, grid.observation_count(seen.voxel));
+    return most;
+  };
+  for (int frame = 0; frame <= 7; ++frame)
+    EXPECT_EQ(most_after(0.001 * frame, frame), 1 + frame / 3) << "frame " << frame;
+  EXPECT_EQ(most_after(0.035, 8), 4);
+  params.spacing_max_frames = -1;
+  EXPECT_THROW(ObservationGrid{params}, Error);
+}
+
 TEST(ObservationGrid, VoxelsWithoutSurfaceAreRetriedEverLessOften) {
   // Frames 0-8 see the wall before any geometry is fused: its voxels find no surface at frame 0
   // and at their first retry (frame 8); the second retry waits twice as long (frame 24).
