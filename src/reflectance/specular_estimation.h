@@ -5,8 +5,8 @@
 // fused over time by a running mean whose divisor is clamped (60), per Ward parameter.
 // With fit_lobe (glint's addition, reflectance/specular_fit.h) a photometric fit of the Ward
 // lobe to the same voxels' observations also runs; where it explains them, its ks and alpha
-// are fused separately and replace the network's once the segment has min_fits of them. kd is
-// always the network's.
+// are fused separately, each weighted by how well it explains the observations, and replace
+// the network's once the segment has min_fits of them. kd is always the network's.
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -61,8 +61,8 @@ class SpecularEstimator {
   SpecularParams params_;
   HemiImageParams hemi_;
   std::map<int, SegmentMaterial> materials_;
-  std::map<int, ClampedRunningMean<7>> fused_;       // the network's (kd, ks, alpha)
-  std::map<int, ClampedRunningMean<4>> fused_lobe_;  // the fits' (ks, alpha)
+  std::map<int, ClampedRunningMean<7>> fused_;        // the network's (kd, ks, alpha)
+  std::map<int, WeightedRunningMean<4>> fused_lobe_;  // the fits' (ks, alpha)
 };
 
 }  // namespace glint::reflectance
