@@ -2,6 +2,7 @@
 // Self2Self.
 #include <algorithm>
 #include <chrono>
+#include <string>
 #include <thread>
 
 #include "core/error.h"
@@ -28,6 +29,14 @@ ImageF denoise_neural(const ImageF& noisy, const ImageF* guidance, const NeuralP
   }
   if (params.iterations < 1 || params.net.levels < 1 || params.net.channels < 1)
     throw Error(method_name(params.method), "", "needs iterations, levels and channels >= 1");
+  // The U-Net halves the image `levels` times; its deepest level needs 2x2 pixels (reflection
+  // padding and batch norm fail on a single row, column or value per channel).
+  const int min_side = (1 << std::min(params.net.levels, 16)) + 1;
+  if (noisy.width() < min_side || noisy.height() < min_side)
+    throw Error("input image", "",
+                "is " + std::to_string(noisy.width()) + "x" + std::to_string(noisy.height()) +
+                    ": a " + std::to_string(params.net.levels) + "-level U-Net needs at least " +
+                    std::to_string(min_side) + " pixels per side (use fewer --levels)");
 
   const auto start = std::chrono::steady_clock::now();
   torch::manual_seed(params.seed);

@@ -225,6 +225,12 @@ TEST(Neural, BadInputsAreErrors) {
   const ImageF wrong(16, 32, 1, 1.f);
   EXPECT_THROW(denoise_neural(s.noisy, &wrong, params), Error);
   EXPECT_THROW(denoise_neural(ImageF(), &s.guidance, params), Error);
+  // The full net's 5 halvings leave a 32x32 image 1x1 at its deepest level: a clear error, not
+  // libtorch's.
+  NeuralParams full = neural_preset(NeuralMethod::dip, "full");
+  full.iterations = 1;
+  EXPECT_THROW(denoise_neural(ImageF(32, 32, 3, 0.5f), nullptr, full), Error);
+  EXPECT_THROW(denoise_neural(ImageF(64, 32, 3, 0.5f), nullptr, full), Error);
   EXPECT_THROW(neural_preset(NeuralMethod::dip, "medium"), Error);
   EXPECT_THROW(parse_neural_method("bm3d"), Error);
   EXPECT_EQ(parse_neural_method("guided-s2s"), NeuralMethod::guided_s2s);
