@@ -104,21 +104,30 @@ TEST(ObservationGrid, ObservationsAccumulateUpToTheCapacity) {
   EXPECT_GT(full, 20);
 }
 
-TEST(ObservationGrid, ObservationsCloserThanTheSpacingToTheNewestAreNotStored) {
-  // min_observation_spacing_deg 1: the camera creeps 1 mm per frame (0.06 degrees at 1 m),
-  // which stores nothing new although every voxel stays seen, then jumps 3 cm (1.7 degrees).
-  fusion::TsdfVolume geometry(geometry_params());
-  fusion::VisibleBlocks blocks;
-  Wall wall;
-  fusion::integrate(geometry, wall.depth, wall.colour, kCamera, Pose::Identity(), blocks);
-  ObservationGridParams params = grid_params();
-  params.min_observation_spacing_deg = 1;
-  ObservationGrid grid(params);
-  const auto pose_at = [](double x_m) {
+// A wall fused once and grid parameters with a 1 degree observation spacing: the spacing
+// tests move the camera along the wall.
+class ObservationSpacing : public ::testing::Test {
+ protected:
+  ObservationSpacing() : geometry(geometry_params()) {
+    fusion::integrate(geometry, wall.depth, wall.colour, kCamera, Pose::Identity(), blocks);
+    params.min_observation_spacing_deg = 1;
+  }
+  static Pose pose_at(double x_m) {
     Pose pose = Pose::Identity();
     pose.translation() = Eigen::Vector3d(x_m, 0, 0);
     return pose;
-  };
+  }
+
+  fusion::TsdfVolume geometry;
+  fusion::VisibleBlocks blocks;
+  Wall wall;
+  ObservationGridParams params = grid_params();
+};
+
+TEST_F(ObservationSpacing, ObservationsCloserThanTheSpacingToTheNewestAreNotStored) {
+  // The camera creeps 1 mm per frame (0.06 degrees at 1 m), which stores nothing new although
+  // every voxel stays seen, then jumps 3 cm (1.7 degrees).
+  ObservationGrid grid(params);
   const std::size_t first_seen =
       grid.collect(wall.depth, wall.colour, kCamera, pose_at(0), 1.0f, geometry, 0).size();
   ASSERT_GT(first_seen, 50u);
@@ -140,23 +149,15 @@ TEST(ObservationGrid, ObservationsCloserThanTheSpacingToTheNewestAreNotStored) {
   EXPECT_THROW(ObservationGrid{params}, Error);
 }
 
-TEST(ObservationGrid, AnObservationIsStoredHoweverCloseOnceTheNewestIsOldEnough) {
+TEST_F(ObservationSpacing, AnObservationIsStoredHoweverCloseOnceTheNewestIsOldEnough) {
   // spacing_max_frames 3: the creeping camera of the test above stores a voxel's first view,
   // then one every third frame, and its jump at once.
-  fusion::TsdfVolume geometry(geometry_params());
-  fusion::VisibleBlocks blocks;
-  Wall wall;
-  fusion::integrate(geometry, wall.depth, wall.colour, kCamera, Pose::Identity(), blocks);
-  ObservationGridParams params = grid_params();
-  params.min_observation_spacing_deg = 1;
   params.spacing_max_frames = 3;
   ObservationGrid grid(params);
   const auto most_after = [&](double x_m, int frame) {
-    Pose pose = Pose::Identity();
-    pose.translation() = Eigen::Vector3d(x_m, 0, 0);
     int most = 0;
     for (const VisibleVoxel& seen :
-         grid.collect(wall.depth, wall.colour, kCamera, pose, 1.0f, geometry, frame))
+         grid.collect(wall.depth, wall.colour, kCamera, pose_at(x_m), 1.0f, geometry, frame))
       most = std::max(most, grid.observation_count(seen.voxel));
     return most;
   };
