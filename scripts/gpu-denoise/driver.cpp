@@ -5,8 +5,8 @@
 // (ITERATIONS, PREDICTIONS 0: the configuration's). GD_DEVICE overrides the device (cuda).
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
-#include <iostream>
 #include <sstream>
 #include <string>
 

@@ -2,12 +2,9 @@
 # for the driver, and its job list: DIP and guided DIP on every image, S2S and guided S2S (a
 # timing: 1,000 steps) on the first.
 import sys, os, numpy as np
-from PIL import Image
+from protocol_images import load
 src, work = sys.argv[1:3]
 os.makedirs(work, exist_ok=True)
-def load(path):
-    a = np.asarray(Image.open(path), dtype=np.float32) / 255.0
-    return a[None] if a.ndim == 2 else a.transpose(2, 0, 1)
 names = sorted(f[:-len("-noisy.png")] for f in os.listdir(src) if f.endswith("-noisy.png"))
 shapes = {}
 for n in names:

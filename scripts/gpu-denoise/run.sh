@@ -23,17 +23,16 @@ nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader
 TORCH=$(python3 -c 'import torch, os; print(os.path.dirname(torch.__file__))')
 ABI=$(python3 -c 'import torch; print(int(torch._C._GLIBCXX_USE_CXX11_ABI))')
 python3 -c 'import torch; print("torch", torch.__version__, torch.cuda.get_device_name(0))'
-SOURCES="unet dip self2self torch_support denoise_neural neural"
-for name in $SOURCES; do
+compile() {  # compile SOURCE: one object in WORK, built in the background
   g++ -O2 -std=c++20 -w -D_GLIBCXX_USE_CXX11_ABI="$ABI" -I"$ROOT/src" -I"$TORCH/include" \
-    -I"$TORCH/include/torch/csrc/api/include" -c "$ROOT/src/denoise/$name.cpp" -o "$WORK/$name.o" &
+    -I"$TORCH/include/torch/csrc/api/include" -c "$1" -o "$WORK/$(basename "$1" .cpp).o" &
+}
+for name in unet dip self2self torch_support denoise_neural neural; do
+  compile "$ROOT/src/denoise/$name.cpp"
 done
-for name in error progress; do
-  g++ -O2 -std=c++20 -w -D_GLIBCXX_USE_CXX11_ABI="$ABI" -I"$ROOT/src" -c "$ROOT/src/core/$name.cpp" \
-    -o "$WORK/$name.o" &
-done
-g++ -O2 -std=c++20 -w -D_GLIBCXX_USE_CXX11_ABI="$ABI" -I"$ROOT/src" -I"$TORCH/include" \
-  -I"$TORCH/include/torch/csrc/api/include" -c "$HERE/driver.cpp" -o "$WORK/driver.o" &
+compile "$ROOT/src/core/error.cpp"
+compile "$ROOT/src/core/progress.cpp"
+compile "$HERE/driver.cpp"
 wait
 # --no-as-needed: nothing references libtorch_cuda directly, but loading it registers CUDA.
 g++ "$WORK"/*.o -o "$WORK/denoise" -L"$TORCH/lib" -Wl,--no-as-needed -ltorch_cuda -lc10_cuda \

@@ -2,12 +2,9 @@
 # denoise/metrics.h) and SSIM (skimage: Gaussian window sigma 1.5, borders left out) of each
 # result the driver's LOG names, against the protocol's clean crop and true noisy mask.
 import sys, os, json, numpy as np
-from PIL import Image
+from protocol_images import load
 from skimage.metrics import structural_similarity
 src, log, out = sys.argv[1:4]
-def load(path):
-    a = np.asarray(Image.open(path), dtype=np.float32) / 255.0
-    return a[None] if a.ndim == 2 else a.transpose(2, 0, 1)
 def psnr(a, b, m=None):
     d = (a - b) ** 2
     mse = d.mean() if m is None else d[:, m].mean()
