@@ -12,4 +12,6 @@ mkdir -p "$OUT"
 "$BUILD/bench/render/render_speed" --data "$DATA" --threads 2 --json "$OUT/render_speed.json"
 "$BUILD/bench/reflectance/reflectance_kernels" --benchmark_out="$OUT/reflectance_kernels.json" \
   --benchmark_out_format=json
+"$BUILD/bench/fusion/fusion_kernels" --benchmark_repetitions=5 \
+  --benchmark_out="$OUT/fusion_kernels.json" --benchmark_out_format=json
 echo "bench: results in $OUT (the reflectance pipeline: scripts/eval-reflectance.sh; the denoising protocol: scripts/eval-denoise.sh)"
