@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "fusion/tsdf_kernels.h"
 #include "fusion/tsdf_sampler.h"
 
 namespace glint::reflectance {
@@ -331,6 +332,7 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
   const int spacing_max_frames =
       params_.spacing_max_frames > 0 ? params_.spacing_max_frames : std::numeric_limits<int>::max();
   const int width = depth_m.width(), height = depth_m.height();
+  const float* depth = depth_m.plane(0);
 
   // One slot per voxel of the frame's blocks; -1 = not observed.
   visible_.assign(frame_blocks_.size() * voxels_per_block_, VisibleVoxel{-1, -1});
@@ -351,6 +353,11 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
   block_refreshed_.assign(blocks, 0);
   parallel_for_chunks(blocks, 16, [&](std::size_t begin, std::size_t end) {
     fusion::TsdfSampler sampler(geometry);  // its block cache serves each block's voxels
+    struct Projection {
+      int pixel, x, y;  // pixel -1: no surface, or not in front of the camera and in the image
+      float z;
+    };
+    std::vector<Projection> projections(voxels_per_block_);
     std::array<Seen, kBatch> seen;
     int pending = 0;
     const auto insert_pending = [&] {
@@ -383,6 +390,10 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
       geometry.hash().prefetch(geometry_block(next_block, geometry_blocks_per_block));
       prefetch_geometry_if_due(geometry, block, frame, geometry_blocks_per_block);
       const Eigen::Vector3i first_voxel = hash_.block(block) * side_;
+      // Two passes over the block's voxels: the first refreshes surfaces, projects them and asks
+      // for the depth under each; the second tests visibility. Voxels come in block order, which
+      // scatters their pixels over images larger than the cache: the depth and colour reads were
+      // a third of this loop's own time (prefetched: 0.3-0.5 ms less per frame on cubes, office).
       for (int local = 0; local < voxels_per_block_; ++local) {
         const Eigen::Vector3i offset(local % side_, (local / side_) % side_,
                                      local / (side_ * side_));
@@ -391,18 +402,30 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
           refresh_surface(v, voxel_centre(first_voxel + offset), frame, sampler);
           if (has_surface_[v]) block_refreshed_[slot] = 1;
         }
+        Projection& projection = projections[local];
+        projection.pixel = -1;
         if (!has_surface_[v]) continue;
-        // Visibility: in the image, in front, facing the camera, not occluded.
+        // In front of the camera and in the image.
         const Eigen::Vector3f q = rotation * position_[v] + translation;
         if (!(q.z() > 0)) continue;
         const float u = float(intrinsics.fx) * q.x() / q.z() + float(intrinsics.cx);
         const float w = float(intrinsics.fy) * q.y() / q.z() + float(intrinsics.cy);
-        const int x = int(std::lround(u)), y = int(std::lround(w));
-        if (x < 0 || y < 0 || x >= width || y >= height) continue;
-        const float measured = depth_m.at(x, y, 0);
-        const float tolerance = float(params_.depth_tolerance_m) +
-                                float(params_.depth_tolerance_sigmas) * kinect_axial_noise_m(q.z());
-        if (!(measured > 0) || std::fabs(measured - q.z()) > tolerance) continue;
+        if (!fusion::nearest_pixel(u, w, width, height, projection.x, projection.y)) continue;
+        projection.pixel = projection.y * width + projection.x;
+        projection.z = q.z();
+        __builtin_prefetch(depth + projection.pixel);
+      }
+      for (int local = 0; local < voxels_per_block_; ++local) {
+        const Projection& projection = projections[local];
+        if (projection.pixel < 0) continue;
+        const int v = block * voxels_per_block_ + local;
+        const int x = projection.x, y = projection.y;
+        // Facing the camera and not occluded.
+        const float measured = depth[projection.pixel];
+        const float tolerance =
+            float(params_.depth_tolerance_m) +
+            float(params_.depth_tolerance_sigmas) * kinect_axial_noise_m(projection.z);
+        if (!(measured > 0) || std::fabs(measured - projection.z) > tolerance) continue;
         const Eigen::Vector3f direction = (camera_centre - position_[v]).normalized();
         if (normal_[v].dot(direction) < float(params_.min_view_cosine)) continue;
         if (observation_count_[v] > 0 && direction.dot(newest_[v].direction) > spacing_cosine &&
@@ -411,6 +434,9 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
           continue;
         }
         prefetch_observations(v, true);
+        // Its colour is read at insertion, a batch later: ask for it now (three planes).
+        for (int channel = 0; channel < 3; ++channel)
+          __builtin_prefetch(colour.plane(channel) + projection.pixel);
         seen[pending++] = {v, int(slot) * voxels_per_block_ + local, x, y, direction};
       }
     }
