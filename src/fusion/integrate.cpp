@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
-#include <cmath>
 #include <cstdint>
 #include <cstring>
 #if defined(__x86_64__)
@@ -98,71 +97,32 @@ struct FrameConstants {
   float fx, fy, cx, cy;
   int width, height;
   float depth_min, depth_max, truncation_m, truncation_per_depth, max_weight;
-  float sdf_quantum_m, codes_per_m;  // the volume's distance code step and its inverse
   const float* depth;
   // One voxel step along the volume's x, y and z axes, in camera coordinates.
   float step_x[3], step_y[3], step_z[3];
 };
 
-// How a row's lanes meet memory: the depth under each lane's pixel, and the row's stored
-// distance codes and weights as floats (codes unscaled) and back, rounded to nearest. Vectors
-// are passed by reference: the calling convention of a by-value vector differs between the
-// baseline and the AVX2 code.
-struct LaneByLane {
-  [[gnu::always_inline]] static void depth(const float* depth, const Ints& pixel, Floats& d) {
-    for (int lane = 0; lane < kBlockSide; ++lane) d[lane] = depth[pixel[lane]];
-  }
-  [[gnu::always_inline]] static void load(const std::int16_t* codes, const std::uint8_t* weights,
-                                          Floats& code, Floats& weight) {
-    for (int lane = 0; lane < kBlockSide; ++lane) {
-      code[lane] = float(codes[lane]);
-      weight[lane] = float(weights[lane]);
-    }
-  }
-  [[gnu::always_inline]] static void store(std::int16_t* codes, std::uint8_t* weights,
-                                           const Floats& code, const Floats& weight) {
-    for (int lane = 0; lane < kBlockSide; ++lane) {
-      codes[lane] =
-          std::int16_t(std::clamp(std::lrint(code[lane]), -long(kMaxSdfCode), long(kMaxSdfCode)));
-      weights[lane] = std::uint8_t(weight[lane]);
-    }
-  }
-};
+// The depth under each lane's pixel. (Vectors are passed by reference: the calling convention
+// of a by-value vector differs between the baseline and the AVX2 code.)
+[[gnu::always_inline]] inline void depth_lane_by_lane(const float* depth, const Ints& pixel,
+                                                      Floats& d) {
+  for (int lane = 0; lane < kBlockSide; ++lane) d[lane] = depth[pixel[lane]];
+}
 #if defined(__x86_64__)
-// AVX2: one vgatherdps instead of 8 extract-load-insert triples (integration is bound by
-// instruction throughput, and they were a quarter of each row's instructions), and packed
-// widening and narrowing, which GCC's generic vectors do lane by lane for bytes.
-struct Avx2Lanes {
-  [[gnu::target("avx2")]] static void depth(const float* depth, const Ints& pixel, Floats& d) {
-    d = Floats(_mm256_i32gather_ps(depth, __m256i(pixel), sizeof(float)));
-  }
-  [[gnu::target("avx2")]] static void load(const std::int16_t* codes, const std::uint8_t* weights,
-                                           Floats& code, Floats& weight) {
-    code = Floats(_mm256_cvtepi32_ps(
-        _mm256_cvtepi16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(codes)))));
-    weight = Floats(_mm256_cvtepi32_ps(
-        _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(weights)))));
-  }
-  [[gnu::target("avx2")]] static void store(std::int16_t* codes, std::uint8_t* weights,
-                                            const Floats& code, const Floats& weight) {
-    const __m256i code32 = _mm256_cvtps_epi32(__m256(code));  // nearest; packs saturate
-    _mm_storeu_si128(
-        reinterpret_cast<__m128i*>(codes),
-        _mm_packs_epi32(_mm256_castsi256_si128(code32), _mm256_extracti128_si256(code32, 1)));
-    const __m256i weight32 = _mm256_cvttps_epi32(__m256(weight));
-    const __m128i weight16 =
-        _mm_packus_epi32(_mm256_castsi256_si128(weight32), _mm256_extracti128_si256(weight32, 1));
-    _mm_storel_epi64(reinterpret_cast<__m128i*>(weights), _mm_packus_epi16(weight16, weight16));
-  }
-};
+// One vgatherdps instead of 8 extract-load-insert triples: integration is bound by instruction
+// throughput, and they were a quarter of each row's instructions.
+[[gnu::target("avx2")]] inline void depth_gathered(const float* depth, const Ints& pixel,
+                                                   Floats& d) {
+  d = Floats(_mm256_i32gather_ps(depth, __m256i(pixel), sizeof(float)));
+}
 #endif
 
 // Fuses the row whose voxel centres are first + i * step_x (camera coordinates,
 // i < kBlockSide); fused_pixel[i] gets the pixel voxel i took its observation from, -1 where it
 // took none.
-template <class Lanes>
+template <auto depth_at>
 [[gnu::always_inline]] inline void integrate_row(const FrameConstants& k, const float first[3],
-                                                 std::int16_t* sdf_codes, std::uint8_t* weights,
+                                                 float* sdf_m, float* weight,
                                                  std::int32_t* fused_pixel) {
   static_assert(kBlockSide == 8);
   const Floats lane{0, 1, 2, 3, 4, 5, 6, 7};
@@ -177,15 +137,15 @@ template <class Lanes>
   const Ints row = __builtin_convertvector(inside ? v + 0.5f : Floats{}, Ints);
   const Ints pixel = row * k.width + column;
   Floats d;
-  Lanes::depth(k.depth, pixel, d);
-  Floats code, w;
-  Lanes::load(sdf_codes, weights, code, w);
-  Floats sdf = code * k.sdf_quantum_m;
+  depth_at(k.depth, pixel, d);
+  Floats sdf, w;
+  std::memcpy(&sdf, sdf_m, sizeof(sdf));
+  std::memcpy(&w, weight, sizeof(w));
   Ints fused;
   fuse_voxel(d - z, k.truncation_m + k.truncation_per_depth * d, k.max_weight,
              inside & (d >= k.depth_min) & (d <= k.depth_max), sdf, w, fused);
-  // A lane not fused keeps its code exactly (not its code scaled there and back).
-  Lanes::store(sdf_codes, weights, fused ? sdf * k.codes_per_m : code, w);
+  std::memcpy(sdf_m, &sdf, sizeof(sdf));
+  std::memcpy(weight, &w, sizeof(w));
   const Ints result = fused ? pixel : -1;
   std::memcpy(fused_pixel, &result, sizeof(result));
 }
@@ -193,46 +153,48 @@ template <class Lanes>
 // Fuses the block whose voxel (0, 0, 0) is at `origin` (camera coordinates); fused_pixel has
 // one entry per voxel, as integrate_row(). The blocks of a frame lie scattered in the pools,
 // so the hardware prefetcher cannot guess the next one: each row fused here fetches the matching
-// row of the next block (`next_codes`, `next_weights`), which hid about half the cache misses.
-template <class Lanes>
+// row of the next block (`next_sdf_m`, `next_weight`), which hid about half the cache misses.
+template <auto depth_at>
 [[gnu::always_inline]] inline void integrate_block(const FrameConstants& constants,
-                                                   const float origin[3], std::int16_t* sdf_codes,
-                                                   std::uint8_t* weights, std::int32_t* fused_pixel,
-                                                   const std::int16_t* next_codes,
-                                                   const std::uint8_t* next_weights) {
+                                                   const float origin[3], float* sdf_m,
+                                                   float* weight, std::int32_t* fused_pixel,
+                                                   const float* next_sdf_m,
+                                                   const float* next_weight) {
   // A local copy: through the reference, every store to the pools could alias the constants,
   // and each row reloaded all of them.
   const FrameConstants k = constants;
-  constexpr int kCodesPerLine = 64 / sizeof(std::int16_t), kWeightsPerLine = 64;
+  constexpr int kFloatsPerLine = 64 / sizeof(float);
   for (int z = 0; z < kBlockSide; ++z) {
     for (int y = 0; y < kBlockSide; ++y) {
       float first[3];
       for (int axis = 0; axis < 3; ++axis)
         first[axis] = origin[axis] + k.step_z[axis] * float(z) + k.step_y[axis] * float(y);
       const int offset = (z * kBlockSide + y) * kBlockSide;
-      if (offset % kCodesPerLine == 0) __builtin_prefetch(next_codes + offset, 1);
-      if (offset % kWeightsPerLine == 0) __builtin_prefetch(next_weights + offset, 1);
-      integrate_row<Lanes>(k, first, sdf_codes + offset, weights + offset, fused_pixel + offset);
+      if (offset % kFloatsPerLine == 0) {
+        __builtin_prefetch(next_sdf_m + offset, 1);
+        __builtin_prefetch(next_weight + offset, 1);
+      }
+      integrate_row<depth_at>(k, first, sdf_m + offset, weight + offset, fused_pixel + offset);
     }
   }
 }
 
-using BlockKernel = void (*)(const FrameConstants&, const float[3], std::int16_t*, std::uint8_t*,
-                             std::int32_t*, const std::int16_t*, const std::uint8_t*);
+using BlockKernel = void (*)(const FrameConstants&, const float[3], float*, float*, std::int32_t*,
+                             const float*, const float*);
 
 [[gnu::flatten]] void integrate_block_baseline(const FrameConstants& k, const float origin[3],
-                                               std::int16_t* sdf_codes, std::uint8_t* weights,
-                                               std::int32_t* fused_pixel,
-                                               const std::int16_t* next_codes,
-                                               const std::uint8_t* next_weights) {
-  integrate_block<LaneByLane>(k, origin, sdf_codes, weights, fused_pixel, next_codes, next_weights);
+                                               float* sdf_m, float* weight,
+                                               std::int32_t* fused_pixel, const float* next_sdf_m,
+                                               const float* next_weight) {
+  integrate_block<depth_lane_by_lane>(k, origin, sdf_m, weight, fused_pixel, next_sdf_m,
+                                      next_weight);
 }
 
 #if defined(__x86_64__)
 [[gnu::target("arch=x86-64-v3"), gnu::flatten]] void integrate_block_x86_64_v3(
-    const FrameConstants& k, const float origin[3], std::int16_t* sdf_codes, std::uint8_t* weights,
-    std::int32_t* fused_pixel, const std::int16_t* next_codes, const std::uint8_t* next_weights) {
-  integrate_block<Avx2Lanes>(k, origin, sdf_codes, weights, fused_pixel, next_codes, next_weights);
+    const FrameConstants& k, const float origin[3], float* sdf_m, float* weight,
+    std::int32_t* fused_pixel, const float* next_sdf_m, const float* next_weight) {
+  integrate_block<depth_gathered>(k, origin, sdf_m, weight, fused_pixel, next_sdf_m, next_weight);
 }
 #endif
 
@@ -270,8 +232,6 @@ void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const Im
                                  static_cast<float>(params.truncation_m),
                                  static_cast<float>(params.truncation_per_depth),
                                  params.max_weight,
-                                 volume.sdf_quantum_m(),
-                                 1.0f / volume.sdf_quantum_m(),
                                  depth_m.plane(0),
                                  {step_x.x(), step_x.y(), step_x.z()},
                                  {step_y.x(), step_y.y(), step_y.z()},
@@ -298,13 +258,14 @@ void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const Im
         (block + frame) % far_every != 0)
       return;
     volume.count_fusion(block);
-    std::uint8_t* weights = volume.weights(block);
+    float* sdf = volume.sdf_m(block);
+    float* weight = volume.weight(block);
     // The weights before this observation, for the colour average.
-    std::array<std::uint8_t, kVoxelsPerBlock> weight_before;
-    if (with_colour) std::copy_n(weights, kVoxelsPerBlock, weight_before.begin());
+    std::array<float, kVoxelsPerBlock> weight_before;
+    if (with_colour) std::copy_n(weight, kVoxelsPerBlock, weight_before.begin());
     std::array<std::int32_t, kVoxelsPerBlock> fused_pixel;
-    fuse_block(constants, origin.data(), volume.sdf_codes(block), weights, fused_pixel.data(),
-               volume.sdf_codes(next_block), volume.weights(next_block));
+    fuse_block(constants, origin.data(), sdf, weight, fused_pixel.data(), volume.sdf_m(next_block),
+               volume.weight(next_block));
     if (!with_colour) return;
     float* red = volume.red(block);
     float* green = volume.green(block);
@@ -312,10 +273,9 @@ void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const Im
     for (int v = 0; v < kVoxelsPerBlock; ++v) {
       const int pixel = fused_pixel[v];
       if (pixel < 0) continue;
-      const float before = weight_before[v];
-      red[v] = fuse_colour(red[v], before, red_in[pixel]);
-      green[v] = fuse_colour(green[v], before, green_in[pixel]);
-      blue[v] = fuse_colour(blue[v], before, blue_in[pixel]);
+      red[v] = fuse_colour(red[v], weight_before[v], red_in[pixel]);
+      green[v] = fuse_colour(green[v], weight_before[v], green_in[pixel]);
+      blue[v] = fuse_colour(blue[v], weight_before[v], blue_in[pixel]);
     }
   });
 }

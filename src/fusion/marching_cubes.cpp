@@ -36,8 +36,8 @@ class BlockNeighbourhood {
     const int block = blocks_[(x >> 3) | ((y >> 3) << 1) | ((z >> 3) << 2)];
     if (block < 0) return false;
     const int voxel = voxel_in_block(x, y, z);
-    if (volume_.weight(block, voxel) == 0) return false;
-    sdf = volume_.sdf_m(block, voxel);
+    if (volume_.weight(block)[voxel] <= 0) return false;
+    sdf = volume_.sdf_m(block)[voxel];
     return true;
   }
   Eigen::Vector3f colour(int x, int y, int z) const {

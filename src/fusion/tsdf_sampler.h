@@ -13,9 +13,7 @@ namespace glint::fusion {
 class TsdfSampler {
  public:
   explicit TsdfSampler(const TsdfVolume& volume)
-      : volume_(volume),
-        inverse_voxel_(1.0f / float(volume.params().voxel_size_m)),
-        sdf_quantum_m_(volume.sdf_quantum_m()) {}
+      : volume_(volume), inverse_voxel_(1.0f / float(volume.params().voxel_size_m)) {}
 
   enum class Sample { unallocated, unobserved, observed };
 
@@ -88,8 +86,8 @@ class TsdfSampler {
     const int block = cached_block(x >> 3, y >> 3, z >> 3);  // floor division by 8
     if (block < 0) return Sample::unallocated;
     const int index = voxel_in_block(x, y, z);
-    if (volume_.weights(block)[index] == 0) return Sample::unobserved;
-    sdf_m = float(volume_.sdf_codes(block)[index]) * sdf_quantum_m_;
+    if (volume_.weight(block)[index] <= 0) return Sample::unobserved;
+    sdf_m = volume_.sdf_m(block)[index];
     return Sample::observed;
   }
 
@@ -118,7 +116,6 @@ class TsdfSampler {
 
   const TsdfVolume& volume_;
   float inverse_voxel_;
-  float sdf_quantum_m_;
   std::array<Eigen::Vector3i, 8> cached_coordinates_;
   std::array<int, 8> block_;
   unsigned cached_ = 0;  // bit e: entry e holds a block

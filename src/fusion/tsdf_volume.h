@@ -4,14 +4,9 @@
 // the pools are allocated once (capacity from VolumeParams) and their pages are committed only
 // as blocks are used. A voxel with weight 0 has never been observed.
 //
-// Voxel values: sdf, signed distance along the viewing ray (positive in front of the surface),
-// clamped to the truncation band; weight, number of fused observations (saturating at
-// max_weight <= 255); red, green, blue, weighted mean linear colour (only in volumes that keep
-// colour). The distance is stored as a 16-bit code in steps of sdf_quantum_m() (the widest
-// band, truncation_at(depth_max_m), over 32767: 1.5 um for the reflectance pipeline) and the
-// weight as a byte: 3 bytes per voxel where float distance and weight took 8, as InfiniTAM
-// stores them (short SDF, uchar weight). The volume is most of the reflectance pipeline's
-// memory after the observations; fusion itself ran no faster (it is bound by its arithmetic).
+// Voxel values: sdf_m, signed distance along the viewing ray in metres (positive in front of the
+// surface), clamped to the truncation band; weight, number of fused observations (saturating);
+// red, green, blue, weighted mean linear colour (only in volumes that keep colour).
 #include <Eigen/Core>
 #include <atomic>
 #include <cstdint>
@@ -24,9 +19,6 @@
 #include "fusion/voxel_block_hash.h"
 
 namespace glint::fusion {
-
-// The largest distance code (the band's edge).
-inline constexpr int kMaxSdfCode = 32767;
 
 // Index within its block of the voxel at global voxel coordinates (x, y, z) (any sign).
 GLINT_HOST_DEVICE inline int voxel_in_block(int x, int y, int z) {
@@ -55,32 +47,24 @@ class TsdfVolume {
   // Whether the volume keeps colour (VolumeParams::colour); red(), green(), blue() need it.
   bool has_colour() const { return params_.colour; }
 
-  // A block's distance codes and weights (kVoxelsPerBlock each).
-  std::int16_t* sdf_codes(int block) { return sdf_codes_.get() + voxel_offset(block); }
-  std::uint8_t* weights(int block) { return weights_.get() + voxel_offset(block); }
-  const std::int16_t* sdf_codes(int block) const { return sdf_codes_.get() + voxel_offset(block); }
-  const std::uint8_t* weights(int block) const { return weights_.get() + voxel_offset(block); }
-  // Metres per distance code.
-  float sdf_quantum_m() const { return sdf_quantum_m_; }
-  // One voxel's distance in metres and weight.
-  float sdf_m(int block, int voxel) const {
-    return float(sdf_codes(block)[voxel]) * sdf_quantum_m_;
-  }
-  int weight(int block, int voxel) const { return weights(block)[voxel]; }
-  // Sets one voxel; the distance is clamped to the representable band, the weight to [0, 255].
-  void set_voxel(int block, int voxel, float sdf_m, int weight);
-
+  float* sdf_m(int block) { return sdf_m_.get() + voxel_offset(block); }
+  float* weight(int block) { return weight_.get() + voxel_offset(block); }
   float* red(int block) { return red_.get() + voxel_offset(block); }
   float* green(int block) { return green_.get() + voxel_offset(block); }
   float* blue(int block) { return blue_.get() + voxel_offset(block); }
+  const float* sdf_m(int block) const { return sdf_m_.get() + voxel_offset(block); }
+  const float* weight(int block) const { return weight_.get() + voxel_offset(block); }
   const float* red(int block) const { return red_.get() + voxel_offset(block); }
   const float* green(int block) const { return green_.get() + voxel_offset(block); }
   const float* blue(int block) const { return blue_.get() + voxel_offset(block); }
 
-  // Asks for a block's distances and weights (1.5 KB) ahead of reading them.
+  // Asks for a block's distances and weights (4 KB) ahead of reading them.
   void prefetch_block(int block) const {
-    prefetch_lines(sdf_codes(block), kVoxelsPerBlock * sizeof(std::int16_t));
-    prefetch_lines(weights(block), kVoxelsPerBlock * sizeof(std::uint8_t));
+    constexpr int kFloatsPerLine = 64 / sizeof(float);
+    for (int offset = 0; offset < kVoxelsPerBlock; offset += kFloatsPerLine) {
+      __builtin_prefetch(sdf_m(block) + offset);
+      __builtin_prefetch(weight(block) + offset);
+    }
   }
 
   // How many frames have been fused into a block (saturating at 255). integrate_blocks counts
@@ -103,10 +87,7 @@ class TsdfVolume {
 
   VolumeParams params_;
   VoxelBlockHash hash_;
-  float sdf_quantum_m_;
-  PoolArray<std::int16_t> sdf_codes_;
-  PoolArray<std::uint8_t> weights_;
-  PoolArray<float> red_, green_, blue_;
+  PoolArray<float> sdf_m_, weight_, red_, green_, blue_;
   PoolArray<std::uint8_t> fusions_;
   std::unique_ptr<std::atomic<int>[]> last_visible_;
 };

@@ -11,9 +11,7 @@ void validate(const VolumeParams& params) {
   if (!(params.voxel_size_m > 0)) fail("voxel_size_m", "must be positive");
   if (!(params.truncation_m > 0) || params.truncation_per_depth < 0)
     fail("truncation_m", "must be positive (and truncation_per_depth non-negative)");
-  // Weights are stored as bytes (tsdf_volume.h).
-  if (!(params.max_weight >= 1 && params.max_weight <= 255))
-    fail("max_weight", "must be in [1, 255]");
+  if (!(params.max_weight >= 1)) fail("max_weight", "must be at least 1");
   if (params.allocation_stride_px < 1) fail("allocation_stride_px", "must be at least 1");
   if (params.block_capacity == 0 || params.block_capacity > (std::size_t{1} << 30))
     fail("block_capacity", "must be in [1, 2^30]");

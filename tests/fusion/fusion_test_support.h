@@ -27,7 +27,8 @@ inline void fill_analytic(TsdfVolume& volume,
               (Eigen::Vector3i(x, y, z) * kBlockSide + Eigen::Vector3i(v % 8, (v / 8) % 8, v / 64))
                   .cast<double>() *
               voxel;
-          volume.set_voxel(b, v, static_cast<float>(std::clamp(sdf(p), -band_m, band_m)), 1);
+          volume.sdf_m(b)[v] = static_cast<float>(std::clamp(sdf(p), -band_m, band_m));
+          volume.weight(b)[v] = 1;
           volume.red(b)[v] = volume.green(b)[v] = volume.blue(b)[v] = 0.5f;
         }
       }

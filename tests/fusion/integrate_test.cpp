@@ -45,12 +45,12 @@ TEST(Integrate, FrontoParallelPlaneGivesTheAnalyticSdf) {
       const double sdf = 1.0 - p.z();
       if (!in_view) continue;
       if (sdf < -0.04 - 1e-6) {
-        EXPECT_EQ(volume.weight(block, v), 0) << "behind the band: never observed";
+        EXPECT_EQ(volume.weight(block)[v], 0.0f) << "behind the band: never observed";
         continue;
       }
       if (sdf < -0.04 + 1e-6) continue;
-      EXPECT_EQ(volume.weight(block, v), 1);
-      EXPECT_NEAR(volume.sdf_m(block, v), std::min(sdf, 0.04), 1e-5) << p.transpose();
+      EXPECT_EQ(volume.weight(block)[v], 1.0f);
+      EXPECT_NEAR(volume.sdf_m(block)[v], std::min(sdf, 0.04), 1e-5) << p.transpose();
       ++checked;
     }
   }
@@ -67,8 +67,8 @@ TEST(Integrate, RepeatedFramesAverageAndColourFollows) {
   const int block = volume.hash().find({0, 0, 12});  // voxels z = 0.96 .. 1.03 m
   ASSERT_GE(block, 0);
   const int voxel = 3 * 64;  // (0, 0, z = 0.99 m)
-  EXPECT_EQ(volume.weight(block, voxel), 2);
-  EXPECT_NEAR(volume.sdf_m(block, voxel), 0.5 * (0.01 + 0.03), 1e-5);
+  EXPECT_EQ(volume.weight(block)[voxel], 2.0f);
+  EXPECT_NEAR(volume.sdf_m(block)[voxel], 0.5 * (0.01 + 0.03), 1e-5);
   EXPECT_NEAR(volume.red(block)[voxel], 0.5, 1e-6);
 }
 
@@ -87,8 +87,8 @@ TEST(Integrate, AVolumeWithoutColourFusesTheSameDistancesAndRefusesColour) {
     const int same = without_colour.hash().find(with_colour.hash().block(b));
     ASSERT_GE(same, 0);
     for (int v = 0; v < kVoxelsPerBlock; ++v) {
-      ASSERT_EQ(without_colour.weight(same, v), with_colour.weight(b, v));
-      ASSERT_EQ(without_colour.sdf_m(same, v), with_colour.sdf_m(b, v));
+      ASSERT_EQ(without_colour.weight(same)[v], with_colour.weight(b)[v]);
+      ASSERT_EQ(without_colour.sdf_m(same)[v], with_colour.sdf_m(b)[v]);
     }
   }
   const Error error = test::error_of([&] {
@@ -124,45 +124,6 @@ TEST(Integrate, MismatchedImagesAndBadParametersAreErrors) {
   bad.far_fusion_every = 0;
   const Error error = test::error_of([&] { TsdfVolume{bad}; });
   EXPECT_NE(std::string(error.what()).find("far_fusion_every"), std::string::npos);
-  bad = plane_params();
-  bad.max_weight = 256;  // weights are stored as bytes
-  const Error weight_error = test::error_of([&] { TsdfVolume{bad}; });
-  EXPECT_NE(std::string(weight_error.what()).find("max_weight"), std::string::npos);
-}
-
-TEST(Integrate, StoredDistancesKeepHalfACodeStepAndTheBand) {
-  VolumeParams params = plane_params();
-  params.truncation_per_depth = 0.01;  // band at depth_max_m = 4 m: 0.04 + 0.04 = 0.08 m
-  TsdfVolume volume(params);
-  EXPECT_FLOAT_EQ(volume.sdf_quantum_m(), 0.08f / kMaxSdfCode);
-  const int block = volume.allocate({0, 0, 0});
-  for (const float sdf : {0.0f, 1e-6f, -0.0123456f, 0.0799f}) {
-    volume.set_voxel(block, 7, sdf, 3);
-    EXPECT_NEAR(volume.sdf_m(block, 7), sdf, 0.5f * volume.sdf_quantum_m()) << sdf;
-    EXPECT_EQ(volume.weight(block, 7), 3);
-  }
-  volume.set_voxel(block, 7, -0.5f, 300);  // beyond the band and the largest weight
-  EXPECT_FLOAT_EQ(volume.sdf_m(block, 7), -0.08f);
-  EXPECT_EQ(volume.weight(block, 7), 255);
-}
-
-TEST(Integrate, WeightSaturatesAtMaxWeightAndTheAverageStillMoves) {
-  VolumeParams params = plane_params();
-  params.max_weight = 255;
-  TsdfVolume volume(params);
-  VisibleBlocks visible;
-  for (int frame = 0; frame < 300; ++frame)
-    integrate(volume, wall_depth(1.0), ImageF(), kCamera, Pose::Identity(), visible);
-  const int block = volume.hash().find({0, 0, 12});  // voxels z = 0.96 .. 1.03 m
-  ASSERT_GE(block, 0);
-  const int voxel = 3 * 64;  // (0, 0, z = 0.99 m): sdf 0.01 m
-  EXPECT_EQ(volume.weight(block, voxel), 255);
-  EXPECT_NEAR(volume.sdf_m(block, voxel), 0.01, 1e-5);
-  // At the saturated weight a new frame still moves the average by 1/256 of its difference
-  // (0.02 m here, 78 um: far more than a code step).
-  integrate(volume, wall_depth(1.02), ImageF(), kCamera, Pose::Identity(), visible);
-  EXPECT_EQ(volume.weight(block, voxel), 255);
-  EXPECT_NEAR(volume.sdf_m(block, voxel), 0.01 + 0.02 / 256, 2e-6);
 }
 
 TEST(Integrate, FarFieldBlocksAreFusedEveryNthFrameStaggered) {
@@ -177,8 +138,8 @@ TEST(Integrate, FarFieldBlocksAreFusedEveryNthFrameStaggered) {
   for (int y = 0; y < kCamera.height; ++y)
     for (int x = kCamera.width / 2; x < kCamera.width; ++x) depth.at(x, y, 0) = 1.6f;
   const auto fused_times = [&](int block) {  // the largest weight in the block
-    const std::uint8_t* weights = volume.weights(block);
-    return int(*std::max_element(weights, weights + kVoxelsPerBlock));
+    const float* weight = volume.weight(block);
+    return int(*std::max_element(weight, weight + kVoxelsPerBlock));
   };
   const auto is_far = [&](int block) {
     return volume.block_origin_m(volume.hash().block(block)).z() + 0.04 > 1.0;

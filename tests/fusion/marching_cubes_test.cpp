@@ -65,7 +65,7 @@ TEST(MarchingCubes, UnobservedVoxelsEmitNothing) {
   TsdfVolume volume;
   EXPECT_TRUE(extract_mesh(volume).triangles.empty());
   const int block = volume.allocate({0, 0, 0});
-  volume.set_voxel(block, 0, -0.01f, 0);  // unobserved
+  volume.sdf_m(block)[0] = -0.01f;  // weight still 0
   EXPECT_TRUE(extract_mesh(volume).vertices.empty());
 }
 
