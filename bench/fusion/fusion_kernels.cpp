@@ -8,7 +8,6 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
-#include <cmath>
 
 #include "fusion/integrate.h"
 #include "reflectance/reflectance_pipeline.h"

@@ -343,7 +343,7 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
   // voxels, and batches of one block left the misses little time). The next block's per-voxel
   // state is prefetched too: the blocks of a frame lie scattered in the pools.
   struct Seen {
-    int voxel, visible_index, x, y;
+    int voxel, visible_index, pixel;  // pixel: y * width + x
     Eigen::Vector3f direction;
   };
   constexpr int kBatch = 128, kInsertFrom = 32;  // voxels pending, and at least this many
@@ -354,7 +354,7 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
   parallel_for_chunks(blocks, 16, [&](std::size_t begin, std::size_t end) {
     fusion::TsdfSampler sampler(geometry);  // its block cache serves each block's voxels
     struct Projection {
-      int pixel, x, y;  // pixel -1: no surface, or not in front of the camera and in the image
+      int pixel;  // y * width + x; -1: no surface, or not in front of the camera and in the image
       float z;
     };
     std::vector<Projection> projections(voxels_per_block_);
@@ -366,8 +366,8 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
         const int v = voxel.voxel;
         Observation observation;
         observation.colour =
-            Eigen::Vector3f(colour.at(voxel.x, voxel.y, 0), colour.at(voxel.x, voxel.y, 1),
-                            colour.at(voxel.x, voxel.y, 2)) *
+            Eigen::Vector3f(colour.plane(0)[voxel.pixel], colour.plane(1)[voxel.pixel],
+                            colour.plane(2)[voxel.pixel]) *
             inverse_exposure;
         observation.direction = voxel.direction;
         observation.frame = std::uint32_t(frame);
@@ -378,7 +378,7 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
             std::uint8_t(insert_observation(observations_.get() + first, nearest_.get() + first,
                                             observation_count_[v], capacity, observation));
         newest_[v] = {voxel.direction, frame};
-        visible_[voxel.visible_index] = {v, voxel.y * width + voxel.x};
+        visible_[voxel.visible_index] = {v, voxel.pixel};
       }
       pending = 0;
     };
@@ -410,8 +410,9 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
         if (!(q.z() > 0)) continue;
         const float u = float(intrinsics.fx) * q.x() / q.z() + float(intrinsics.cx);
         const float w = float(intrinsics.fy) * q.y() / q.z() + float(intrinsics.cy);
-        if (!fusion::nearest_pixel(u, w, width, height, projection.x, projection.y)) continue;
-        projection.pixel = projection.y * width + projection.x;
+        int x, y;
+        if (!fusion::nearest_pixel(u, w, width, height, x, y)) continue;
+        projection.pixel = y * width + x;
         projection.z = q.z();
         __builtin_prefetch(depth + projection.pixel);
       }
@@ -419,7 +420,6 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
         const Projection& projection = projections[local];
         if (projection.pixel < 0) continue;
         const int v = block * voxels_per_block_ + local;
-        const int x = projection.x, y = projection.y;
         // Facing the camera and not occluded.
         const float measured = depth[projection.pixel];
         const float tolerance =
@@ -430,14 +430,14 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
         if (normal_[v].dot(direction) < float(params_.min_view_cosine)) continue;
         if (observation_count_[v] > 0 && direction.dot(newest_[v].direction) > spacing_cosine &&
             frame - newest_[v].frame < spacing_max_frames) {
-          visible_[int(slot) * voxels_per_block_ + local] = {v, y * width + x};
+          visible_[int(slot) * voxels_per_block_ + local] = {v, projection.pixel};
           continue;
         }
         prefetch_observations(v, true);
         // Its colour is read at insertion, a batch later: ask for it now (three planes).
         for (int channel = 0; channel < 3; ++channel)
           __builtin_prefetch(colour.plane(channel) + projection.pixel);
-        seen[pending++] = {v, int(slot) * voxels_per_block_ + local, x, y, direction};
+        seen[pending++] = {v, int(slot) * voxels_per_block_ + local, projection.pixel, direction};
       }
     }
     insert_pending();
