@@ -14,6 +14,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "fusion/integrate_frame.h"
 #include "fusion/tsdf_kernels.h"
 
 namespace glint::fusion {
@@ -92,15 +93,6 @@ namespace {
 // kernel is compiled twice and picked once at run time), SSE pairs otherwise.
 using Floats = float __attribute__((vector_size(kBlockSide * sizeof(float))));
 using Ints = std::int32_t __attribute__((vector_size(kBlockSide * sizeof(std::int32_t))));
-
-struct FrameConstants {
-  float fx, fy, cx, cy;
-  int width, height;
-  float depth_min, depth_max, truncation_m, truncation_per_depth, max_weight;
-  const float* depth;
-  // One voxel step along the volume's x, y and z axes, in camera coordinates.
-  float step_x[3], step_y[3], step_z[3];
-};
 
 // The depth under each lane's pixel. (Vectors are passed by reference: the calling convention
 // of a by-value vector differs between the baseline and the AVX2 code.)
@@ -207,35 +199,46 @@ BlockKernel block_kernel() {
 
 }  // namespace
 
-void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const ImageF& depth_m,
-                      const ImageF& colour, const Intrinsics& intrinsics,
-                      const Pose& camera_to_world) {
+FrameIntegration::FrameIntegration(const TsdfVolume& volume, const VisibleBlocks& visible,
+                                   const ImageF& depth_m, const ImageF& colour,
+                                   const Intrinsics& intrinsics, const Pose& camera_to_world)
+    : volume_(volume) {
   require_same_size(depth_m, colour, intrinsics);
   if (!colour.empty() && !volume.has_colour())
     throw Error("TSDF volume", "colour", "keeps no colour (VolumeParams::colour is off)");
   const VolumeParams& params = volume.params();
   const Pose world_to_camera = camera_to_world.inverse();
-  const Eigen::Matrix3f rotation = world_to_camera.linear().cast<float>();
-  const Eigen::Vector3f translation = world_to_camera.translation().cast<float>();
+  rotation_ = world_to_camera.linear().cast<float>();
+  translation_ = world_to_camera.translation().cast<float>();
   const float voxel = static_cast<float>(params.voxel_size_m);
-  const Eigen::Vector3f step_x = rotation.col(0) * voxel;
-  const Eigen::Vector3f step_y = rotation.col(1) * voxel;
-  const Eigen::Vector3f step_z = rotation.col(2) * voxel;
-  const FrameConstants constants{static_cast<float>(intrinsics.fx),
-                                 static_cast<float>(intrinsics.fy),
-                                 static_cast<float>(intrinsics.cx),
-                                 static_cast<float>(intrinsics.cy),
-                                 depth_m.width(),
-                                 depth_m.height(),
-                                 static_cast<float>(params.depth_min_m),
-                                 static_cast<float>(params.depth_max_m),
-                                 static_cast<float>(params.truncation_m),
-                                 static_cast<float>(params.truncation_per_depth),
-                                 params.max_weight,
-                                 depth_m.plane(0),
-                                 {step_x.x(), step_x.y(), step_x.z()},
-                                 {step_y.x(), step_y.y(), step_y.z()},
-                                 {step_z.x(), step_z.y(), step_z.z()}};
+  const Eigen::Vector3f step_x = rotation_.col(0) * voxel;
+  const Eigen::Vector3f step_y = rotation_.col(1) * voxel;
+  const Eigen::Vector3f step_z = rotation_.col(2) * voxel;
+  constants_ = FrameConstants{static_cast<float>(intrinsics.fx),
+                              static_cast<float>(intrinsics.fy),
+                              static_cast<float>(intrinsics.cx),
+                              static_cast<float>(intrinsics.cy),
+                              depth_m.width(),
+                              depth_m.height(),
+                              static_cast<float>(params.depth_min_m),
+                              static_cast<float>(params.depth_max_m),
+                              static_cast<float>(params.truncation_m),
+                              static_cast<float>(params.truncation_per_depth),
+                              params.max_weight,
+                              depth_m.plane(0),
+                              {step_x.x(), step_x.y(), step_x.z()},
+                              {step_y.x(), step_y.y(), step_y.z()},
+                              {step_z.x(), step_z.y(), step_z.z()}};
+  half_block_ = (step_x + step_y + step_z) * (0.5f * kBlockSide);
+  far_depth_ = float(params.far_field_depth_m(intrinsics.fx));
+  far_every_ = params.far_fusion_every;
+  frame_ = std::max(visible.frame, 0);
+}
+
+void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const ImageF& depth_m,
+                      const ImageF& colour, const Intrinsics& intrinsics,
+                      const Pose& camera_to_world) {
+  const FrameIntegration frame(volume, visible, depth_m, colour, intrinsics, camera_to_world);
   const bool with_colour = !colour.empty();
   const float* red_in = with_colour ? colour.plane(0) : nullptr;
   const float* green_in = with_colour ? colour.plane(1) : nullptr;
@@ -243,20 +246,11 @@ void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const Im
 
   static const BlockKernel fuse_block = block_kernel();
   const std::size_t blocks = visible.indices.size();
-  const Eigen::Vector3f half_block = (step_x + step_y + step_z) * (0.5f * kBlockSide);
-  const float far_depth = float(params.far_field_depth_m(intrinsics.fx));
-  const int far_every = params.far_fusion_every;
-  const int frame = std::max(visible.frame, 0);
   parallel_for(blocks, [&](std::size_t i) {
     const int block = visible.indices[i];
     const int next_block = visible.indices[i + 1 < blocks ? i + 1 : i];
-    const Eigen::Vector3f origin =
-        rotation * volume.block_origin_m(volume.hash().block(block)).cast<float>() + translation;
-    // A far block's first fusion is never put off: until then it holds no surface for the
-    // reflectance pipeline's observation voxels to find.
-    if (far_every > 1 && (origin + half_block).z() > far_depth && volume.fusions(block) > 0 &&
-        (block + frame) % far_every != 0)
-      return;
+    const Eigen::Vector3f origin = frame.block_origin(block);
+    if (!frame.fused_now(block, origin)) return;
     volume.count_fusion(block);
     float* sdf = volume.sdf_m(block);
     float* weight = volume.weight(block);
@@ -264,8 +258,8 @@ void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const Im
     std::array<float, kVoxelsPerBlock> weight_before;
     if (with_colour) std::copy_n(weight, kVoxelsPerBlock, weight_before.begin());
     std::array<std::int32_t, kVoxelsPerBlock> fused_pixel;
-    fuse_block(constants, origin.data(), sdf, weight, fused_pixel.data(), volume.sdf_m(next_block),
-               volume.weight(next_block));
+    fuse_block(frame.constants(), origin.data(), sdf, weight, fused_pixel.data(),
+               volume.sdf_m(next_block), volume.weight(next_block));
     if (!with_colour) return;
     float* red = volume.red(block);
     float* green = volume.green(block);

@@ -1,6 +1,6 @@
 #pragma once
-// Per-voxel and per-ray maths of TSDF fusion, as small inline functions that the TBB loops call
-// and a CUDA kernel could call too (no allocation, no exceptions).
+// Per-voxel and per-ray maths of TSDF fusion, as small inline functions that the TBB loops and
+// the CUDA kernels (cuda_integrator.cu) call (no allocation, no exceptions).
 #include <cmath>
 
 #include "fusion/host_device.h"
@@ -31,6 +31,17 @@ GLINT_HOST_DEVICE inline float fuse_colour(float mean, float weight_before, floa
   return (mean * weight_before + observation) / (weight_before + 1.0f);
 }
 
+// One frame's integration constants, in camera coordinates (plain data: the CUDA kernel gets a
+// copy with `depth` pointing into device memory).
+struct FrameConstants {
+  float fx, fy, cx, cy;
+  int width, height;
+  float depth_min, depth_max, truncation_m, truncation_per_depth, max_weight;
+  const float* depth;
+  // One voxel step along the volume's x, y and z axes, in camera coordinates.
+  float step_x[3], step_y[3], step_z[3];
+};
+
 // Nearest pixel of a projected point, or false when it falls outside a width x height image.
 GLINT_HOST_DEVICE inline bool nearest_pixel(float u, float v, int width, int height, int& x,
                                             int& y) {
@@ -38,6 +49,24 @@ GLINT_HOST_DEVICE inline bool nearest_pixel(float u, float v, int width, int hei
   x = static_cast<int>(u + 0.5f);
   y = static_cast<int>(v + 0.5f);
   return true;
+}
+
+// Fuses the voxel at camera coordinates (x, y, z) with the depth under its nearest pixel: the
+// scalar form of the CPU's row kernel (integrate.cpp), one voxel per CUDA thread. Returns the
+// pixel it took its observation from, or -1 where it took none.
+GLINT_HOST_DEVICE inline int fuse_voxel_projective(const FrameConstants& k, float x, float y,
+                                                   float z, float& sdf_m, float& weight) {
+  const float inverse_z = 1.0f / z;
+  int column = 0, row = 0;
+  const bool inside =
+      z > 0 && nearest_pixel(k.fx * x * inverse_z + k.cx, k.fy * y * inverse_z + k.cy, k.width,
+                             k.height, column, row);
+  const int pixel = inside ? row * k.width + column : 0;
+  const float d = inside ? k.depth[pixel] : 0.0f;
+  bool fused = false;
+  fuse_voxel(d - z, k.truncation_m + k.truncation_per_depth * d, k.max_weight,
+             inside && d >= k.depth_min && d <= k.depth_max, sdf_m, weight, fused);
+  return fused ? pixel : -1;
 }
 
 // Calls visit(bx, by, bz) for every cell of a grid of side `cell` that the segment a -> b
