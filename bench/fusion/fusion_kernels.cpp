@@ -2,15 +2,17 @@
 // (fx 365 px) of a room corner 1.5-4.5 m away, with the reflectance pipeline's volume (5 mm
 // voxels, band 2 cm + 0.5 cm per metre, no colour): block allocation, and integration of the
 // frame's visible blocks into a volume that has already fused it (steady state). Items are
-// voxels.
+// voxels. Where glint is built with CUDA and a GPU is present, also the same integration on the
+// GPU (fusion/cuda_integrator.h), the fused voxels written through to the host's pools.
 //   fusion_kernels [--benchmark_repetitions=5 --benchmark_out=FILE.json
 //   --benchmark_out_format=json]
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 
+#include "fusion/cuda_integrator.h"
 #include "fusion/integrate.h"
-#include "reflectance/reflectance_pipeline.h"
+#include "reflectance/reflectance_volume.h"
 
 namespace {
 
@@ -39,10 +41,8 @@ ImageF corner_depth() {
   return depth;
 }
 
-VolumeParams pipeline_volume() { return reflectance::ReflectanceParams{}.geometry.volume; }
-
 void AllocateBlocks(benchmark::State& state) {
-  TsdfVolume volume(pipeline_volume());
+  TsdfVolume volume(reflectance::reflectance_volume_params());
   const ImageF depth = corner_depth();
   VisibleBlocks visible;
   for (auto _ : state) allocate_blocks(volume, depth, kKinect, Pose::Identity(), visible);
@@ -51,7 +51,7 @@ void AllocateBlocks(benchmark::State& state) {
 BENCHMARK(AllocateBlocks)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void IntegrateBlocks(benchmark::State& state) {
-  TsdfVolume volume(pipeline_volume());
+  TsdfVolume volume(reflectance::reflectance_volume_params());
   const ImageF depth = corner_depth();
   VisibleBlocks visible;
   integrate(volume, depth, ImageF(), kKinect, Pose::Identity(), visible);
@@ -62,6 +62,25 @@ void IntegrateBlocks(benchmark::State& state) {
                           kVoxelsPerBlock);
 }
 BENCHMARK(IntegrateBlocks)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The same on the GPU: depth upload, kernel, and the fused voxels written through to the host.
+void CudaIntegrateBlocks(benchmark::State& state) {
+  if (!CudaIntegrator::available()) {
+    state.SkipWithError("no CUDA build or no GPU");
+    return;
+  }
+  TsdfVolume volume(reflectance::reflectance_volume_params());
+  const ImageF depth = corner_depth();
+  VisibleBlocks visible;
+  integrate(volume, depth, ImageF(), kKinect, Pose::Identity(), visible);
+  CudaIntegrator integrator(volume);
+  for (auto _ : state)
+    integrator.integrate_blocks(volume, visible, depth, ImageF(), kKinect, Pose::Identity());
+  state.counters["blocks"] = double(visible.indices.size());
+  state.SetItemsProcessed(state.iterations() * std::int64_t(visible.indices.size()) *
+                          kVoxelsPerBlock);
+}
+BENCHMARK(CudaIntegrateBlocks)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

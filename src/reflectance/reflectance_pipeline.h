@@ -17,6 +17,7 @@
 #include "reflectance/depth_segmentation.h"
 #include "reflectance/hemicnn.h"
 #include "reflectance/observation_grid.h"
+#include "reflectance/reflectance_volume.h"
 #include "reflectance/segment_map.h"
 #include "reflectance/specular_estimation.h"
 #include "render/scene.h"
@@ -24,14 +25,7 @@
 namespace glint::reflectance {
 
 struct ReflectanceParams {
-  // Depth up to 6 m (the fusion default is 4 m): the paper's synthetic scenes are seen from 4 m
-  // away, so their far objects lie at 5-5.5 m. The truncation band grows by 0.5 cm per metre
-  // of depth instead of VoxelHashing's 1 cm: at 5 m it is then +-4.5 cm instead of +-7 cm
-  // (measured on cubes: refined-RGB PSNR 27.63 -> 27.94 dB, geometry 8.3 -> 6.9 ms per frame;
-  // 0.25 cm and less left holes, 26.2 dB and below).
-  fusion::FusionParams geometry{
-      .volume = {.truncation_per_depth = 0.005, .depth_max_m = 6.0, .colour = false},
-      .tracking = {}};
+  fusion::FusionParams geometry{.volume = reflectance_volume_params(), .tracking = {}};
   // Observations 1 degree apart at least (ObservationGridParams::min_observation_spacing_deg;
   // chosen on cubes, where 1 degree changed no metric beyond run-to-run spread and 2 degrees
   // cost 0.3 dB refined RGB; office held out: +0.8 dB, observation stage -3.6 ms per frame),
@@ -83,6 +77,8 @@ class ReflectancePipeline {
                            const Image<std::int32_t>* ground_truth_segments = nullptr);
 
   const fusion::TsdfVolume& geometry() const { return geometry_.volume(); }
+  // Where the geometry's TSDF integration runs: "cpu" or "cuda".
+  const char* integration_device() const { return geometry_.integration_device(); }
   const ObservationGrid& observations() const { return grid_; }
   const SegmentMap& segments() const { return segment_map_; }
   const SpecularEstimator& materials() const { return specular_; }

@@ -1,0 +1,66 @@
+#pragma once
+// The GPU side of CudaIntegrator (cuda_device_pools.cu): device copies of a TSDF volume's voxel
+// pools, the host pools pinned so that the fusion kernel writes each changed voxel through to
+// them, and that kernel. Plain types only, so that nvcc never compiles Eigen. Every call is
+// synchronous and throws glint::Error naming the CUDA failure.
+#include <cstddef>
+#include <vector>
+
+#include "fusion/tsdf_kernels.h"
+#include "fusion/volume_params.h"
+
+namespace glint::fusion {
+
+class CudaDevicePools {
+ public:
+  // Pool arrays per voxel, in this order: sdf, weight, and red, green, blue where kept.
+  static constexpr int kMaxFields = 5;
+
+  // Whether a CUDA device is present (false, not an error, without a driver).
+  static bool device_present();
+
+  // host[f]: field f's host pool (block 0), of `capacity_blocks` blocks. The host pools must
+  // outlive this object.
+  CudaDevicePools(float* const* host, int fields, std::size_t capacity_blocks);
+  ~CudaDevicePools();
+  CudaDevicePools(const CudaDevicePools&) = delete;
+  CudaDevicePools& operator=(const CudaDevicePools&) = delete;
+
+  // Mirrors blocks [0, blocks): blocks not yet on the GPU are copied from the host (`upload`)
+  // or, when the caller knows them to be zero (freshly allocated), zeroed.
+  void mirror(std::size_t blocks, bool upload);
+  std::size_t mirrored() const { return mirrored_; }
+  // Field f's host pool (block 0).
+  const float* host_pool(int f) const { return host_[f]; }
+
+  // Fuses `count` blocks (pool indices `blocks`, each mirrored; `origins`, 3 floats per block,
+  // the camera coordinates of each block's voxel (0, 0, 0)) with the host depth image k.depth
+  // (k.width x k.height) and, where `colour` is not null, its 3 host colour planes. Each voxel
+  // that takes an observation is written to the GPU's pools and to the host's.
+  void fuse(const FrameConstants& k, const float* const* colour, const int* blocks,
+            const float* origins, std::size_t count);
+
+ private:
+  // Pins the host pools of blocks [0, blocks), 1024 blocks (2 MiB a field) at a time.
+  void pin_host(std::size_t blocks);
+
+  int fields_;
+  std::size_t capacity_blocks_;
+  float* host_[kMaxFields] = {};
+  std::vector<void*> pinned_;  // registered host ranges
+  std::size_t pinned_blocks_ = 0;
+  std::size_t mirrored_ = 0;
+  std::size_t device_blocks_ = 0;  // room in pools_
+  float* pools_[kMaxFields] = {};
+  // Per-frame input on the device, grown as needed.
+  float* depth_ = nullptr;
+  std::size_t depth_capacity_ = 0;
+  float* colour_ = nullptr;
+  std::size_t colour_capacity_ = 0;
+  int* blocks_ = nullptr;
+  std::size_t blocks_capacity_ = 0;
+  float* origins_ = nullptr;
+  std::size_t origins_capacity_ = 0;
+};
+
+}  // namespace glint::fusion
