@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <string>
 
 #include "cli_support.h"
 #include "commands.h"
@@ -100,10 +101,10 @@ void run_fuse(const FuseOptions& options) {
   const auto& volume = options.params.volume;
   log().info(
       "{} ({}, {} frames{}): {} blocks, mesh {} vertices / {} triangles -> {}; integrate "
-      "{:.1f} ms/frame{}",
+      "{:.1f} ms/frame on the {}{}",
       options.dataset, sequence.format, frames, tracked ? "" : ", ground-truth poses",
       pipeline.volume().block_count(), mesh.vertices.size(), mesh.triangles.size(), options.mesh,
-      pipeline.timings().median_ms("integrate"),
+      pipeline.timings().median_ms("integrate"), pipeline.integration_device(),
       ate.is_null() ? std::string()
                     : fmt::format(", ATE RMSE {:.4f} m", ate["rmse_m"].get<double>()));
   if (!options.report.empty())
@@ -124,7 +125,8 @@ void run_fuse(const FuseOptions& options) {
                                       {"truncation_per_depth", volume.truncation_per_depth},
                                       {"depth_max_m", volume.depth_max_m},
                                       {"block_capacity", volume.block_capacity},
-                                      {"ground_truth_poses", !tracked}}},
+                                      {"ground_truth_poses", !tracked},
+                                      {"integration_device", pipeline.integration_device()}}},
                                     {"blocks", pipeline.volume().block_count()},
                                     {"mesh",
                                      {{"vertices", mesh.vertices.size()},
@@ -171,6 +173,22 @@ void add_volume_options(CLI::App* command, fusion::VolumeParams& volume) {
       ->capture_default_str();
 }
 
+void add_integration_device_option(CLI::App* command, fusion::IntegrationDevice& device) {
+  device = fusion::IntegrationDevice::automatic;
+  command
+      ->add_option_function<std::string>(
+          "--device",
+          [&device](const std::string& name) {
+            device = name == "cpu"    ? fusion::IntegrationDevice::cpu
+                     : name == "cuda" ? fusion::IntegrationDevice::cuda
+                                      : fusion::IntegrationDevice::automatic;
+          },
+          "Where TSDF integration runs: cpu, cuda (a GPU, in a build configured with "
+          "-DGLINT_WITH_CUDA=ON), or auto (the GPU where there is one)")
+      ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
+      ->default_str("auto");
+}
+
 void register_fuse_command(CLI::App& app) {
   auto options = std::make_shared<FuseOptions>();
   CLI::App* command = app.add_subcommand(
@@ -184,6 +202,7 @@ void register_fuse_command(CLI::App& app) {
   command->add_option("-o,--output", options->mesh, "Mesh (PLY, binary, sRGB vertex colours)")
       ->required();
   add_volume_options(command, options->params.volume);
+  add_integration_device_option(command, options->params.device);
   command->add_flag("--gt-poses", options->params.use_ground_truth_poses,
                     "Use the dataset's ground-truth poses instead of tracking");
   command->add_option("--frames", options->frames, "Use the first N frames (0 = all)")

@@ -237,6 +237,7 @@ void run_reconstruct(ReconstructOptions options) {
        {"parameters",
         {{"obs_voxel_m", options.params.observations.voxel_size_m},
          {"voxel_m", options.params.geometry.volume.voxel_size_m},
+         {"integration_device", pipeline.integration_device()},
          {"observations_per_voxel", options.params.observations.observations_per_voxel},
          {"obs_spacing_deg", options.params.observations.min_observation_spacing_deg},
          {"obs_spacing_frames", options.params.observations.spacing_max_frames},
@@ -305,6 +306,7 @@ void register_reconstruct_command(CLI::App& app) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   add_volume_options(command, params.geometry.volume);
+  add_integration_device_option(command, params.geometry.device);
   command->add_flag("--gt-poses", params.geometry.use_ground_truth_poses,
                     "Use the dataset's ground-truth poses instead of tracking");
   command->add_flag("--gt-segmentation", options->ground_truth_segmentation,

@@ -2,11 +2,15 @@
 // The TSDF volume's command-line options, shared by `glint fuse` and `glint reconstruct`.
 #include <CLI/CLI.hpp>
 
+#include "fusion/fusion_pipeline.h"
 #include "fusion/volume_params.h"
 
 namespace glint::app {
 
 // --voxel, --trunc, --trunc-per-depth, --depth-max, --blocks onto `volume`.
 void add_volume_options(CLI::App* command, fusion::VolumeParams& volume);
+
+// --device cpu|cuda|auto (default auto): where TSDF integration runs.
+void add_integration_device_option(CLI::App* command, fusion::IntegrationDevice& device);
 
 }  // namespace glint::app

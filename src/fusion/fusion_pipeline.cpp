@@ -5,7 +5,11 @@
 namespace glint::fusion {
 
 FusionPipeline::FusionPipeline(const Intrinsics& intrinsics, const FusionParams& params)
-    : intrinsics_(intrinsics), params_(params), volume_(params.volume) {}
+    : intrinsics_(intrinsics), params_(params), volume_(params.volume) {
+  if (params.device == IntegrationDevice::cuda ||
+      (params.device == IntegrationDevice::automatic && CudaIntegrator::available()))
+    gpu_ = std::make_unique<CudaIntegrator>(volume_);
+}
 
 Pose FusionPipeline::predict_pose() const {
   if (poses_.size() < 2) return poses_.back();
@@ -37,9 +41,14 @@ FrameResult FusionPipeline::process(const io::RgbdFrame& frame) {
     Stopwatch watch;
     allocate_blocks(volume_, frame.depth_m, intrinsics_, result.camera_to_world, visible_);
     const double allocate_ms = watch.elapsed_ms();
-    integrate_blocks(volume_, visible_, frame.depth_m,
-                     volume_.has_colour() ? frame.colour : ImageF(), intrinsics_,
-                     result.camera_to_world);
+    const ImageF no_colour;
+    const ImageF& colour = volume_.has_colour() ? frame.colour : no_colour;
+    if (gpu_)
+      gpu_->integrate_blocks(volume_, visible_, frame.depth_m, colour, intrinsics_,
+                             result.camera_to_world);
+    else
+      integrate_blocks(volume_, visible_, frame.depth_m, colour, intrinsics_,
+                       result.camera_to_world);
     timings_.add("integrate", watch.elapsed_ms());
     timings_.add("allocate_blocks", allocate_ms);
     result.integrated = true;

@@ -3,10 +3,12 @@
 // pose estimation (ICP against the model, or the dataset's ground truth), TSDF integration, and
 // the model ray cast that the next frame is tracked against. Stage durations are recorded as
 // "track", "integrate" and "raycast".
+#include <memory>
 #include <optional>
 
 #include "core/camera.h"
 #include "core/timer.h"
+#include "fusion/cuda_integrator.h"
 #include "fusion/icp_tracker.h"
 #include "fusion/integrate.h"
 #include "fusion/raycast.h"
@@ -15,11 +17,16 @@
 
 namespace glint::fusion {
 
+// Where TSDF integration runs: the CPU, a CUDA GPU (CudaIntegrator: a GLINT_WITH_CUDA build and
+// a GPU, else an error), or the GPU where there is one.
+enum class IntegrationDevice { cpu, cuda, automatic };
+
 struct FusionParams {
   VolumeParams volume;
   TrackingParams tracking;
   // Use each frame's ground-truth pose instead of tracking (frames without one are errors).
   bool use_ground_truth_poses = false;
+  IntegrationDevice device = IntegrationDevice::cpu;
 };
 
 struct FrameResult {
@@ -31,6 +38,7 @@ struct FrameResult {
 
 class FusionPipeline {
  public:
+  // Throws glint::Error when params.device is cuda and CUDA is not available.
   FusionPipeline(const Intrinsics& intrinsics, const FusionParams& params);
 
   // Fuses one frame. The first frame is placed at its ground-truth pose when it has one, else at
@@ -39,6 +47,8 @@ class FusionPipeline {
   FrameResult process(const io::RgbdFrame& frame);
 
   const TsdfVolume& volume() const { return volume_; }
+  // Where integration runs: "cpu" or "cuda".
+  const char* integration_device() const { return gpu_ ? "cuda" : "cpu"; }
   const StageTimings& timings() const { return timings_; }
 
  private:
@@ -47,6 +57,7 @@ class FusionPipeline {
   Intrinsics intrinsics_;
   FusionParams params_;
   TsdfVolume volume_;
+  std::unique_ptr<CudaIntegrator> gpu_;  // after volume_: unpins its pools before they go
   VisibleBlocks visible_;
   StageTimings timings_;
   SurfaceView model_;

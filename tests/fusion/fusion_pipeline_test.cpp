@@ -57,6 +57,39 @@ TEST(FusionPipeline, TrackingRunsAndReportsEveryFrame) {
   EXPECT_EQ(pipeline.timings().to_json()["raycast"]["count"], 3);
 }
 
+// The GPU path against the CPU one where there is a GPU; otherwise the device choice alone: cuda
+// is a clear error, auto falls back to the CPU.
+TEST(FusionPipeline, IntegrationDeviceChoice) {
+  const io::RgbdSequence sequence = fixture();
+  FusionParams params = small_params(true);
+  params.device = IntegrationDevice::automatic;
+  FusionPipeline automatic(sequence.intrinsics, params);
+  params.device = IntegrationDevice::cuda;
+  if (!CudaIntegrator::available()) {
+    EXPECT_STREQ(automatic.integration_device(), "cpu");
+    EXPECT_THROW(FusionPipeline(sequence.intrinsics, params), Error);
+    return;
+  }
+  FusionPipeline gpu(sequence.intrinsics, params);
+  params.device = IntegrationDevice::cpu;
+  FusionPipeline cpu(sequence.intrinsics, params);
+  EXPECT_STREQ(gpu.integration_device(), "cuda");
+  for (std::size_t i = 0; i < sequence.frames.size(); ++i) {
+    const io::RgbdFrame frame = io::read_rgbd_frame(sequence, i);
+    gpu.process(frame);
+    cpu.process(frame);
+  }
+  ASSERT_EQ(gpu.volume().block_count(), cpu.volume().block_count());
+  for (std::size_t b = 0; b < cpu.volume().block_count(); ++b) {
+    const int other = gpu.volume().hash().find(cpu.volume().hash().block(int(b)));
+    ASSERT_GE(other, 0);
+    for (int v = 0; v < kVoxelsPerBlock; ++v) {
+      EXPECT_EQ(gpu.volume().weight(other)[v], cpu.volume().weight(int(b))[v]);
+      EXPECT_NEAR(gpu.volume().sdf_m(other)[v], cpu.volume().sdf_m(int(b))[v], 1e-5);
+    }
+  }
+}
+
 TEST(FusionPipeline, ExhaustedPoolAndMissingGroundTruthAreErrors) {
   const io::RgbdSequence sequence = fixture();
   FusionParams params = small_params(true);
