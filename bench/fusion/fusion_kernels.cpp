@@ -2,8 +2,8 @@
 // (fx 365 px) of a room corner 1.5-4.5 m away, with the reflectance pipeline's volume (5 mm
 // voxels, band 2 cm + 0.5 cm per metre, no colour): block allocation, and integration of the
 // frame's visible blocks into a volume that has already fused it (steady state). Items are
-// voxels. Where glint is built with CUDA and a GPU is present, also the same integration on the
-// GPU (fusion/cuda_integrator.h), the fused voxels written through to the host's pools.
+// voxels. In a CUDA build (GLINT_WITH_CUDA), where a GPU is present, also the same integration on
+// the GPU (fusion/cuda_integrator.h), the fused voxels written through to the host's pools.
 //   fusion_kernels [--benchmark_repetitions=5 --benchmark_out=FILE.json
 //   --benchmark_out_format=json]
 #include <benchmark/benchmark.h>
@@ -63,10 +63,11 @@ void IntegrateBlocks(benchmark::State& state) {
 }
 BENCHMARK(IntegrateBlocks)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+#if defined(GLINT_WITH_CUDA)
 // The same on the GPU: depth upload, kernel, and the fused voxels written through to the host.
 void CudaIntegrateBlocks(benchmark::State& state) {
   if (!CudaIntegrator::available()) {
-    state.SkipWithError("no CUDA build or no GPU");
+    state.SkipWithError("no GPU");
     return;
   }
   TsdfVolume volume(reflectance::reflectance_volume_params());
@@ -81,6 +82,7 @@ void CudaIntegrateBlocks(benchmark::State& state) {
                           kVoxelsPerBlock);
 }
 BENCHMARK(CudaIntegrateBlocks)->Unit(benchmark::kMillisecond)->UseRealTime();
+#endif
 
 }  // namespace
 
