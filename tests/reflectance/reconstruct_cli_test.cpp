@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "fusion/cuda_integrator.h"
 #include "io/json_report.h"
 #include "reflectance/hemicnn.h"
 #include "support/cli_fixture.h"
@@ -46,6 +47,9 @@ TEST_F(ReconstructCli, WritesTheModelMaterialsLightsPicturesAndReport) {
   EXPECT_GE(report["evaluation"]["objects"].size(), 2u);
   EXPECT_TRUE(report["evaluation"]["average"].contains("kd_ref"));
   EXPECT_GE(report["materials"]["segments"].size(), 2u);
+  // --device auto: the GPU where this build has CUDA and there is one.
+  EXPECT_EQ(report["parameters"]["integration_device"],
+            fusion::CudaIntegrator::available() ? "cuda" : "cpu");
   // The table is printed.
   EXPECT_NE(result.output.find("kd_ref"), std::string::npos);
 }
@@ -71,6 +75,15 @@ TEST_F(ReconstructCli, BadInputsFailClearly) {
                  "/scene.json -o " + path("x"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("scene.json"), std::string::npos) << result.output;
+  result = glint("reconstruct " + path("seq") + " --gt-lights --device gpu -o " + path("x"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("--device"), std::string::npos) << result.output;
+  if (!fusion::CudaIntegrator::available()) {
+    result = glint("reconstruct " + path("seq") + " --gt-lights --model " + path("model.json") +
+                   " --device cuda -o " + path("x"));
+    EXPECT_NE(result.exit_code, 0);
+    EXPECT_NE(result.output.find("CUDA"), std::string::npos) << result.output;
+  }
   EXPECT_FALSE(fs::exists(path("x") + "/mesh.ply"));
 }
 
