@@ -42,9 +42,9 @@ struct FieldPointers {
 // One CUDA block per TSDF block, one thread per voxel (voxel = (z * 8 + y) * 8 + x), so that a
 // warp reads and writes 32 consecutive floats of each pool. Voxels that take no observation
 // keep their values on both sides and are not written: the host pools are reached over PCIe.
+// `colour` is null for a frame fused without colour.
 __global__ void fuse_blocks(FrameConstants k, FieldPointers device, FieldPointers host,
-                            bool with_colour, const float* colour, const int* blocks,
-                            const float* origins) {
+                            const float* colour, const int* blocks, const float* origins) {
   const int v = threadIdx.x;
   const int x = v & (kBlockSide - 1), y = (v / kBlockSide) & (kBlockSide - 1),
             z = v / (kBlockSide * kBlockSide);
@@ -60,7 +60,7 @@ __global__ void fuse_blocks(FrameConstants k, FieldPointers device, FieldPointer
   if (pixel < 0) return;
   device.field[0][voxel] = host.field[0][voxel] = sdf;
   device.field[1][voxel] = host.field[1][voxel] = weight;
-  if (!with_colour) return;
+  if (!colour) return;
   const std::size_t plane = std::size_t(k.width) * k.height;
   for (int c = 0; c < 3; ++c) {
     const float mean =
@@ -80,10 +80,10 @@ bool CudaDevicePools::device_present() {
   return devices > 0;
 }
 
-CudaDevicePools::CudaDevicePools(float* const* host, int fields, std::size_t capacity_blocks)
-    : fields_(fields), capacity_blocks_(capacity_blocks) {
+CudaDevicePools::CudaDevicePools(const HostPools& host, std::size_t capacity_blocks)
+    : fields_(host.count), capacity_blocks_(capacity_blocks) {
   if (!device_present()) throw Error("CUDA", "", "no CUDA device is present (or no driver for it)");
-  std::copy_n(host, fields, host_);
+  std::copy_n(host.field, kMaxFields, host_);
 }
 
 CudaDevicePools::~CudaDevicePools() {
@@ -150,7 +150,7 @@ void CudaDevicePools::mirror(std::size_t blocks, bool upload) {
   mirrored_ = blocks;
 }
 
-void CudaDevicePools::fuse(const FrameConstants& k, const float* const* colour, const int* blocks,
+void CudaDevicePools::fuse(const FrameConstants& k, const float* colour, const int* blocks,
                            const float* origins, std::size_t count) {
   if (count == 0) return;
   const std::size_t pixels = std::size_t(k.width) * k.height;
@@ -158,13 +158,10 @@ void CudaDevicePools::fuse(const FrameConstants& k, const float* const* colour, 
   on_device.depth = grown(depth_, depth_capacity_, pixels);
   check(cudaMemcpy(depth_, k.depth, pixels * sizeof(float), cudaMemcpyHostToDevice),
         "uploading the depth image");
-  if (colour) {
-    grown(colour_, colour_capacity_, 3 * pixels);
-    for (int c = 0; c < 3; ++c)
-      check(cudaMemcpy(colour_ + c * pixels, colour[c], pixels * sizeof(float),
-                       cudaMemcpyHostToDevice),
-            "uploading the colour image");
-  }
+  if (colour)
+    check(cudaMemcpy(grown(colour_, colour_capacity_, 3 * pixels), colour,
+                     3 * pixels * sizeof(float), cudaMemcpyHostToDevice),
+          "uploading the colour image");
   check(cudaMemcpy(grown(blocks_, blocks_capacity_, count), blocks, count * sizeof(int),
                    cudaMemcpyHostToDevice),
         "uploading the block list");
@@ -174,8 +171,8 @@ void CudaDevicePools::fuse(const FrameConstants& k, const float* const* colour, 
   FieldPointers device{}, host{};
   std::copy_n(pools_, fields_, device.field);
   std::copy_n(host_, fields_, host.field);
-  fuse_blocks<<<unsigned(count), kVoxelsPerBlock>>>(on_device, device, host, colour != nullptr,
-                                                    colour_, blocks_, origins_);
+  fuse_blocks<<<unsigned(count), kVoxelsPerBlock>>>(on_device, device, host,
+                                                    colour ? colour_ : nullptr, blocks_, origins_);
   check(cudaGetLastError(), "launching the fusion kernel");
   check(cudaDeviceSynchronize(), "fusing blocks");
 }

@@ -19,9 +19,14 @@ class CudaDevicePools {
   // Whether a CUDA device is present (false, not an error, without a driver).
   static bool device_present();
 
-  // host[f]: field f's host pool (block 0), of `capacity_blocks` blocks. The host pools must
-  // outlive this object.
-  CudaDevicePools(float* const* host, int fields, std::size_t capacity_blocks);
+  // A volume's host pools: field f's at block 0, for the first `count` fields.
+  struct HostPools {
+    float* field[kMaxFields] = {};
+    int count = 0;
+  };
+
+  // `host` holds `capacity_blocks` blocks per field and must outlive this object.
+  CudaDevicePools(const HostPools& host, std::size_t capacity_blocks);
   ~CudaDevicePools();
   CudaDevicePools(const CudaDevicePools&) = delete;
   CudaDevicePools& operator=(const CudaDevicePools&) = delete;
@@ -29,16 +34,16 @@ class CudaDevicePools {
   // Mirrors blocks [0, blocks): blocks not yet on the GPU are copied from the host (`upload`)
   // or, when the caller knows them to be zero (freshly allocated), zeroed.
   void mirror(std::size_t blocks, bool upload);
-  std::size_t mirrored() const { return mirrored_; }
   // Field f's host pool (block 0).
   const float* host_pool(int f) const { return host_[f]; }
 
   // Fuses `count` blocks (pool indices `blocks`, each mirrored; `origins`, 3 floats per block,
   // the camera coordinates of each block's voxel (0, 0, 0)) with the host depth image k.depth
-  // (k.width x k.height) and, where `colour` is not null, its 3 host colour planes. Each voxel
-  // that takes an observation is written to the GPU's pools and to the host's.
-  void fuse(const FrameConstants& k, const float* const* colour, const int* blocks,
-            const float* origins, std::size_t count);
+  // (k.width x k.height) and, where `colour` is not null, the host colour image (3 planes one
+  // after the other, as ImageF keeps them). Each voxel that takes an observation is written to
+  // the GPU's pools and to the host's.
+  void fuse(const FrameConstants& k, const float* colour, const int* blocks, const float* origins,
+            std::size_t count);
 
  private:
   // Pins the host pools of blocks [0, blocks), 1024 blocks (2 MiB a field) at a time.
@@ -46,7 +51,7 @@ class CudaDevicePools {
 
   int fields_;
   std::size_t capacity_blocks_;
-  float* host_[kMaxFields] = {};
+  float* host_[kMaxFields];
   std::vector<void*> pinned_;  // registered host ranges
   std::size_t pinned_blocks_ = 0;
   std::size_t mirrored_ = 0;

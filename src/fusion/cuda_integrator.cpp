@@ -2,7 +2,6 @@
 
 #include "core/error.h"
 #if defined(GLINT_WITH_CUDA)
-#include <array>
 #include <vector>
 
 #include "fusion/cuda_device_pools.h"
@@ -16,17 +15,15 @@ namespace glint::fusion {
 namespace {
 
 // The volume's host pools at block 0, in CudaDevicePools' order of fields.
-std::array<float*, CudaDevicePools::kMaxFields> host_pools(TsdfVolume& volume) {
-  if (!volume.has_colour()) return {volume.sdf_m(0), volume.weight(0)};
-  return {volume.sdf_m(0), volume.weight(0), volume.red(0), volume.green(0), volume.blue(0)};
+CudaDevicePools::HostPools host_pools(TsdfVolume& volume) {
+  if (!volume.has_colour()) return {{volume.sdf_m(0), volume.weight(0)}, 2};
+  return {{volume.sdf_m(0), volume.weight(0), volume.red(0), volume.green(0), volume.blue(0)}, 5};
 }
 
 }  // namespace
 
 struct CudaIntegrator::Device {
-  explicit Device(TsdfVolume& volume)
-      : pools(host_pools(volume).data(), volume.has_colour() ? 5 : 2,
-              volume.params().block_capacity) {}
+  explicit Device(TsdfVolume& volume) : pools(host_pools(volume), volume.params().block_capacity) {}
   CudaDevicePools pools;
   std::vector<int> fused;  // this frame's fused blocks and their origins
   std::vector<float> origins;
@@ -58,10 +55,7 @@ void CudaIntegrator::integrate_blocks(TsdfVolume& volume, const VisibleBlocks& v
     device.fused.push_back(block);
     device.origins.insert(device.origins.end(), origin.data(), origin.data() + 3);
   }
-  const std::array<const float*, 3> planes = {colour.empty() ? nullptr : colour.plane(0),
-                                              colour.empty() ? nullptr : colour.plane(1),
-                                              colour.empty() ? nullptr : colour.plane(2)};
-  device.pools.fuse(frame.constants(), colour.empty() ? nullptr : planes.data(),
+  device.pools.fuse(frame.constants(), colour.empty() ? nullptr : colour.plane(0),
                     device.fused.data(), device.origins.data(), device.fused.size());
 }
 
