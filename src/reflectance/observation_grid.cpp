@@ -107,14 +107,25 @@ Eigen::Vector3i ObservationGrid::geometry_block(int block, float geometry_blocks
   return {int(std::floor(centre.x())), int(std::floor(centre.y())), int(std::floor(centre.z()))};
 }
 
-void ObservationGrid::prefetch_geometry_if_due(const fusion::TsdfVolume& geometry, int block,
-                                               int frame, float geometry_blocks_per_block) const {
-  const int* next_refresh = next_refresh_frame_.get() + std::size_t(block) * voxels_per_block_;
-  if (std::none_of(next_refresh, next_refresh + voxels_per_block_,
-                   [&](int due) { return frame >= due; }))
-    return;
-  const int index = geometry.hash().find(geometry_block(block, geometry_blocks_per_block));
-  if (index >= 0) geometry.prefetch_block(index);
+unsigned ObservationGrid::geometry_blocks_due(int block, int frame) const {
+  // A surface refresh reads a 4^3 stencil of TSDF voxels around the point (TsdfSampler::
+  // trilinear_with_gradient): from a voxel in the block's last layer along an axis it reaches
+  // into the next geometry block along that axis.
+  const int first = block * voxels_per_block_;
+  unsigned reaches_next = 0;  // bit a: a due voxel's stencil reaches the next block along axis a
+  bool due = false;
+  for (int local = 0; local < voxels_per_block_; ++local) {
+    if (frame < next_refresh_frame_[first + local]) continue;
+    due = true;
+    const int coordinates[3] = {local % side_, (local / side_) % side_, local / (side_ * side_)};
+    for (int axis = 0; axis < 3; ++axis)
+      if (coordinates[axis] == side_ - 1) reaches_next |= 1u << axis;
+  }
+  if (!due) return 0;
+  unsigned blocks = 0;  // bit (x | y << 1 | z << 2) for the geometry block at that offset
+  for (unsigned offset = 0; offset < 8; ++offset)
+    if ((offset & ~reaches_next) == 0) blocks |= 1u << offset;
+  return blocks;
 }
 
 ObservationGrid::ObservationGrid(const ObservationGridParams& params)
@@ -360,6 +371,14 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
     std::vector<Projection> projections(voxels_per_block_);
     std::array<Seen, kBatch> seen;
     int pending = 0;
+    // geometry_blocks_due() of the blocks ahead, by slot % 4.
+    std::array<unsigned, 4> due_geometry{};
+    const auto for_each_geometry_block = [&](int block, unsigned due, auto&& visit) {
+      const Eigen::Vector3i origin = geometry_block(block, geometry_blocks_per_block);
+      for (unsigned offset = 0; offset < 8; ++offset)
+        if (due >> offset & 1)
+          visit(origin + Eigen::Vector3i(offset & 1, (offset >> 1) & 1, (offset >> 2) & 1));
+    };
     const auto insert_pending = [&] {
       for (int i = 0; i < pending; ++i) {
         const Seen& voxel = seen[i];
@@ -384,11 +403,33 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
     };
     for (std::size_t slot = begin; slot < end; ++slot) {
       if (pending >= kInsertFrom || pending + voxels_per_block_ > kBatch) insert_pending();
+      // A software pipeline over the blocks. Three ahead: the voxel state. Two ahead: the hash
+      // slots of the geometry blocks that the due refreshes' stencils reach, including the
+      // neighbours beyond the block under this one. One ahead: those blocks' voxels. With only the
+      // block under this one asked for, just before use, the refreshes stalled on the TSDF's
+      // reads (cubes: 1,410 TSC cycles per refresh; 760 with the pipeline).
+      const auto ahead = [&](std::size_t n) {
+        return frame_blocks_[std::min(slot + n, blocks - 1)];
+      };
+      if (slot == begin) {
+        for (std::size_t n = 0; n < 3; ++n) prefetch_voxel_state(ahead(n));
+        for (std::size_t n = 0; n < 2; ++n)
+          due_geometry[(slot + n) % 4] = geometry_blocks_due(ahead(n), frame);
+        for_each_geometry_block(ahead(0), due_geometry[slot % 4], [&](const Eigen::Vector3i& g) {
+          const int index = geometry.hash().find(g);
+          if (index >= 0) geometry.prefetch_block(index);
+        });
+      }
+      prefetch_voxel_state(ahead(3));
+      due_geometry[(slot + 2) % 4] = geometry_blocks_due(ahead(2), frame);
+      for_each_geometry_block(ahead(2), due_geometry[(slot + 2) % 4],
+                              [&](const Eigen::Vector3i& g) { geometry.hash().prefetch(g); });
+      for_each_geometry_block(ahead(1), due_geometry[(slot + 1) % 4],
+                              [&](const Eigen::Vector3i& g) {
+                                const int index = geometry.hash().find(g);
+                                if (index >= 0) geometry.prefetch_block(index);
+                              });
       const int block = frame_blocks_[slot];
-      const int next_block = frame_blocks_[slot + 1 < blocks ? slot + 1 : slot];
-      prefetch_voxel_state(next_block);
-      geometry.hash().prefetch(geometry_block(next_block, geometry_blocks_per_block));
-      prefetch_geometry_if_due(geometry, block, frame, geometry_blocks_per_block);
       const Eigen::Vector3i first_voxel = hash_.block(block) * side_;
       // Two passes over the block's voxels: the first refreshes surfaces, projects them and asks
       // for the depth under each; the second tests visibility. Voxels come in block order, which

@@ -179,10 +179,10 @@ class ObservationGrid {
   // The geometry (TSDF) block that holds the centre of observation block `block`, given the
   // ratio of the two block sizes.
   Eigen::Vector3i geometry_block(int block, float geometry_blocks_per_block) const;
-  // When a voxel of `block` is due for a surface refresh in `frame`, prefetches the geometry
-  // block its stencils mostly read: read voxel by voxel, each cache miss stalled the next.
-  void prefetch_geometry_if_due(const fusion::TsdfVolume& geometry, int block, int frame,
-                                float geometry_blocks_per_block) const;
+  // The geometry blocks that the surface refreshes due in `frame` for the voxels of `block` read:
+  // bit (x | y << 1 | z << 2) for the block at that offset from geometry_block(); 0 when none is
+  // due.
+  unsigned geometry_blocks_due(int block, int frame) const;
 
   ObservationGridParams params_;
   int side_ = 2;
