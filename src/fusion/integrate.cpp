@@ -156,11 +156,15 @@ template <auto depth_at>
   // and each row reloaded all of them.
   const FrameConstants k = constants;
   constexpr int kFloatsPerLine = 64 / sizeof(float);
+  const Floats lane{0, 1, 2, 3, 4, 5, 6, 7};
   for (int z = 0; z < kBlockSide; ++z) {
+    // The first voxel of each of the slice's rows, one row per lane: computed row by row, these
+    // scalar sums were a sixth of the block's instructions.
+    Floats row_first[3];
+    for (int axis = 0; axis < 3; ++axis)
+      row_first[axis] = (origin[axis] + k.step_z[axis] * float(z)) + lane * k.step_y[axis];
     for (int y = 0; y < kBlockSide; ++y) {
-      float first[3];
-      for (int axis = 0; axis < 3; ++axis)
-        first[axis] = origin[axis] + k.step_z[axis] * float(z) + k.step_y[axis] * float(y);
+      const float first[3] = {row_first[0][y], row_first[1][y], row_first[2][y]};
       const int offset = (z * kBlockSide + y) * kBlockSide;
       if (offset % kFloatsPerLine == 0) {
         __builtin_prefetch(next_sdf_m + offset, 1);
