@@ -93,6 +93,7 @@ namespace {
 // kernel is compiled twice and picked once at run time), SSE pairs otherwise.
 using Floats = float __attribute__((vector_size(kBlockSide * sizeof(float))));
 using Ints = std::int32_t __attribute__((vector_size(kBlockSide * sizeof(std::int32_t))));
+constexpr Floats kLanes{0, 1, 2, 3, 4, 5, 6, 7};
 
 // The depth under each lane's pixel. (Vectors are passed by reference: the calling convention
 // of a by-value vector differs between the baseline and the AVX2 code.)
@@ -117,9 +118,8 @@ template <auto depth_at>
                                                  float* sdf_m, float* weight,
                                                  std::int32_t* fused_pixel) {
   static_assert(kBlockSide == 8);
-  const Floats lane{0, 1, 2, 3, 4, 5, 6, 7};
-  const Floats x = first[0] + lane * k.step_x[0], y = first[1] + lane * k.step_x[1],
-               z = first[2] + lane * k.step_x[2];
+  const Floats x = first[0] + kLanes * k.step_x[0], y = first[1] + kLanes * k.step_x[1],
+               z = first[2] + kLanes * k.step_x[2];
   const Floats inverse_z = 1.0f / z;
   const Floats u = k.fx * x * inverse_z + k.cx, v = k.fy * y * inverse_z + k.cy;
   // nearest_pixel() for every lane; outside lanes read pixel 0 and are masked off.
@@ -156,13 +156,12 @@ template <auto depth_at>
   // and each row reloaded all of them.
   const FrameConstants k = constants;
   constexpr int kFloatsPerLine = 64 / sizeof(float);
-  const Floats lane{0, 1, 2, 3, 4, 5, 6, 7};
   for (int z = 0; z < kBlockSide; ++z) {
     // The first voxel of each of the slice's rows, one row per lane: computed row by row, these
     // scalar sums were a sixth of the block's instructions.
     Floats row_first[3];
     for (int axis = 0; axis < 3; ++axis)
-      row_first[axis] = (origin[axis] + k.step_z[axis] * float(z)) + lane * k.step_y[axis];
+      row_first[axis] = (origin[axis] + k.step_z[axis] * float(z)) + kLanes * k.step_y[axis];
     for (int y = 0; y < kBlockSide; ++y) {
       const float first[3] = {row_first[0][y], row_first[1][y], row_first[2][y]};
       const int offset = (z * kBlockSide + y) * kBlockSide;

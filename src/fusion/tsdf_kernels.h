@@ -1,6 +1,6 @@
 #pragma once
 // Per-voxel and per-ray maths of TSDF fusion, as small inline functions that the TBB loops and
-// the CUDA kernels (cuda_integrator.cu) call (no allocation, no exceptions).
+// the CUDA kernel (cuda_device_pools.cu) call (no allocation, no exceptions).
 #include <cmath>
 
 #include "fusion/host_device.h"

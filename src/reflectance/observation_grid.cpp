@@ -117,7 +117,7 @@ unsigned ObservationGrid::geometry_blocks_due(int block, int frame) const {
   for (int local = 0; local < voxels_per_block_; ++local) {
     if (frame < next_refresh_frame_[first + local]) continue;
     due = true;
-    const int coordinates[3] = {local % side_, (local / side_) % side_, local / (side_ * side_)};
+    const Eigen::Vector3i coordinates = local_coordinates(local);
     for (int axis = 0; axis < 3; ++axis)
       if (coordinates[axis] == side_ - 1) reaches_next |= 1u << axis;
   }
@@ -185,8 +185,7 @@ int ObservationGrid::find(const Eigen::Vector3f& p) const {
 
 Eigen::Vector3i ObservationGrid::voxel_coordinates(int v) const {
   const int block = v / voxels_per_block_, local = v % voxels_per_block_;
-  return hash_.block(block) * side_ +
-         Eigen::Vector3i(local % side_, (local / side_) % side_, local / (side_ * side_));
+  return hash_.block(block) * side_ + local_coordinates(local);
 }
 
 void ObservationGrid::allocate(const ImageF& depth_m, const Intrinsics& intrinsics,
@@ -411,33 +410,32 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
       const auto ahead = [&](std::size_t n) {
         return frame_blocks_[std::min(slot + n, blocks - 1)];
       };
+      const auto prefetch_geometry = [&](std::size_t n) {
+        for_each_geometry_block(ahead(n), due_geometry[(slot + n) % 4],
+                                [&](const Eigen::Vector3i& g) {
+                                  const int index = geometry.hash().find(g);
+                                  if (index >= 0) geometry.prefetch_block(index);
+                                });
+      };
       if (slot == begin) {
         for (std::size_t n = 0; n < 3; ++n) prefetch_voxel_state(ahead(n));
         for (std::size_t n = 0; n < 2; ++n)
           due_geometry[(slot + n) % 4] = geometry_blocks_due(ahead(n), frame);
-        for_each_geometry_block(ahead(0), due_geometry[slot % 4], [&](const Eigen::Vector3i& g) {
-          const int index = geometry.hash().find(g);
-          if (index >= 0) geometry.prefetch_block(index);
-        });
+        prefetch_geometry(0);
       }
       prefetch_voxel_state(ahead(3));
       due_geometry[(slot + 2) % 4] = geometry_blocks_due(ahead(2), frame);
       for_each_geometry_block(ahead(2), due_geometry[(slot + 2) % 4],
                               [&](const Eigen::Vector3i& g) { geometry.hash().prefetch(g); });
-      for_each_geometry_block(ahead(1), due_geometry[(slot + 1) % 4],
-                              [&](const Eigen::Vector3i& g) {
-                                const int index = geometry.hash().find(g);
-                                if (index >= 0) geometry.prefetch_block(index);
-                              });
-      const int block = frame_blocks_[slot];
+      prefetch_geometry(1);
+      const int block = ahead(0);
       const Eigen::Vector3i first_voxel = hash_.block(block) * side_;
       // Two passes over the block's voxels: the first refreshes surfaces, projects them and asks
       // for the depth under each; the second tests visibility. Voxels come in block order, which
       // scatters their pixels over images larger than the cache: the depth and colour reads were
       // a third of this loop's own time (prefetched: 0.3-0.5 ms less per frame on cubes, office).
       for (int local = 0; local < voxels_per_block_; ++local) {
-        const Eigen::Vector3i offset(local % side_, (local / side_) % side_,
-                                     local / (side_ * side_));
+        const Eigen::Vector3i offset = local_coordinates(local);
         const int v = block * voxels_per_block_ + local;
         if (frame >= next_refresh_frame_[v]) {
           refresh_surface(v, voxel_centre(first_voxel + offset), frame, sampler);

@@ -159,6 +159,10 @@ class ObservationGrid {
                ? 0
                : std::size_t(observation_set_[v] - 1) * params_.observations_per_voxel;
   }
+  // Coordinates within its block of the voxel with in-block index `local`.
+  Eigen::Vector3i local_coordinates(int local) const {
+    return {local % side_, (local / side_) % side_, local / (side_ * side_)};
+  }
   int voxel_index(int block, const Eigen::Vector3i& local) const {
     return block * voxels_per_block_ + (local.z() * side_ + local.y()) * side_ + local.x();
   }
