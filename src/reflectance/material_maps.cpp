@@ -142,6 +142,7 @@ bool material_at(const ObservationGrid& grid, const SpecularEstimator& materials
   const SegmentMaterial* fused = materials.material(material.segment);
   if (!fused) return false;
   material.fused = material.refined = fused->ward;
+  if (fused->kd_refined) material.refined.kd = *fused->kd_refined;
   interpolate_refined_kd(grid, p, material.segment, material.refined.kd);
   return true;
 }

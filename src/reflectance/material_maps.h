@@ -44,7 +44,9 @@ bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& 
                             Eigen::Vector3f& kd);
 
 // The material at surface point p: the segment of the voxel holding p (else of the nearest
-// labelled neighbour voxel), its fused Ward parameters, and the same with the refined kd.
+// labelled neighbour voxel), its fused Ward parameters, and the same with the refined kd (the
+// segment's fused refined kd where interpolate_refined_kd finds none; the network's before
+// the segment has one).
 // False when p lies in no segment with a material yet.
 struct PointMaterial {
   int segment = 0;

@@ -1,5 +1,7 @@
 #include "reflectance/reflectance_pipeline.h"
 
+#include <tbb/enumerable_thread_specific.h>
+
 #include <algorithm>
 #include <string>
 
@@ -59,7 +61,12 @@ void ReflectancePipeline::refine_albedo_of_visible() {
   // with its data in cache), so each chunk runs a two-stage prefetch: a voxel's own state
   // kVoxelAhead iterations early, then, once that has arrived, its observations.
   constexpr std::size_t kVoxelAhead = 8, kObservationsAhead = 3;
+  // Per thread and segment: the sum of the reliable refined kd (rgb) and their count.
+  const int segments = segment_map_.max_segment_id() + 1;
+  tbb::enumerable_thread_specific<std::vector<Eigen::Vector4f>> sums(std::size_t(segments),
+                                                                     Eigen::Vector4f::Zero());
   parallel_for_chunks(albedo_due_.size(), 64, [&](std::size_t begin, std::size_t end) {
+    std::vector<Eigen::Vector4f>& segment_sums = sums.local();
     for (std::size_t i = begin; i < std::min(begin + kVoxelAhead, end); ++i)
       grid_.prefetch_voxel(albedo_due_[i]);
     for (std::size_t i = begin; i < end; ++i) {
@@ -67,7 +74,8 @@ void ReflectancePipeline::refine_albedo_of_visible() {
       if (i + kObservationsAhead < end)
         grid_.prefetch_observations(albedo_due_[i + kObservationsAhead], false);
       const int v = albedo_due_[i];
-      const SegmentMaterial* material = specular_.material(grid_.segment(v));
+      const int segment = grid_.segment(v);
+      const SegmentMaterial* material = specular_.material(segment);
       if (!material) continue;
       const auto refined = refine_albedo(
           grid_.observations(v), grid_.observation_count(v), grid_.position(v), grid_.normal(v),
@@ -77,8 +85,17 @@ void ReflectancePipeline::refine_albedo_of_visible() {
       if (!refined) continue;
       grid_.refined_kd(v) = refined->kd.cwiseMax(0.0f).cwiseMin(1.0f);
       grid_.refined_kd_reliable(v) = refined->light_cosine >= params_.albedo_min_light_cosine;
+      if (grid_.refined_kd_reliable(v) && segment < segments)
+        segment_sums[segment] += (Eigen::Vector4f() << grid_.refined_kd(v), 1.0f).finished();
     }
   });
+  // Each segment's mean over its voxels solved reliably in this frame, into its
+  // SegmentMaterial::kd_refined.
+  for (int segment = 1; segment < segments; ++segment) {
+    Eigen::Vector4f sum = Eigen::Vector4f::Zero();
+    for (const auto& local : sums) sum += local[segment];
+    if (sum.w() > 0) specular_.fuse_refined_albedo(segment, sum.head<3>() / sum.w());
+  }
 }
 
 const Image<std::int32_t>& ReflectancePipeline::segment_frame(const ImageF& depth_m) {

@@ -89,6 +89,9 @@ class ReflectancePipeline {
   int frames_processed() const { return frame_; }
 
  private:
+  // Solves the due voxels' albedo (eq. 7), and fuses each segment's mean over its reliable ones
+  // into its SegmentMaterial::kd_refined: the albedo a re-rendering falls back on where no voxel
+  // nearby has one (unlit or unobserved parts; the paper assumes a segment homogeneous).
   void refine_albedo_of_visible();
   // The depth segmentation's labels at full resolution: the segmenter's own without halvings,
   // else frame_labels_ filled from the coarse ones.

@@ -49,6 +49,14 @@ const SegmentMaterial* SpecularEstimator::material(int segment) const {
   return found == materials_.end() ? nullptr : &found->second;
 }
 
+void SpecularEstimator::fuse_refined_albedo(int segment, const Eigen::Vector3f& kd) {
+  const auto material = materials_.find(segment);
+  if (material == materials_.end()) return;
+  auto& fused = fused_refined_kd_.try_emplace(segment, params_.fusion_divisor).first->second;
+  fused.add(kd);
+  material->second.kd_refined = fused.mean();
+}
+
 void SpecularEstimator::update(const ObservationGrid& grid, const SegmentMap& segment_map,
                                const std::vector<int>& segments,
                                const std::vector<render::PointLight>& lights, int frame) {

@@ -39,6 +39,10 @@ struct SegmentMaterial {
   int estimates = 0;            // frames that produced an estimate
   int fitted = 0;               // of those, frames whose ks, alpha came from the lobe fit
   int last_frame = -1;
+  // The segment's refined diffuse albedo (§3.7): per frame the mean refined kd of its voxels
+  // solved reliably in it, fused over frames like the estimates. The re-rendering's albedo where
+  // no voxel around a point has a refined one (reflectance/material_maps.h); unset before then.
+  std::optional<Eigen::Vector3f> kd_refined;
 };
 
 class SpecularEstimator {
@@ -52,6 +56,10 @@ class SpecularEstimator {
               const std::vector<int>& segments, const std::vector<render::PointLight>& lights,
               int frame);
 
+  // Fuses one frame's refined albedo of `segment` into its SegmentMaterial::kd_refined; ignored
+  // for a segment without a material yet.
+  void fuse_refined_albedo(int segment, const Eigen::Vector3f& kd);
+
   // The fused material of a segment, or nullptr before its first estimate.
   const SegmentMaterial* material(int segment) const;
   const std::map<int, SegmentMaterial>& materials() const { return materials_; }
@@ -63,6 +71,7 @@ class SpecularEstimator {
   std::map<int, SegmentMaterial> materials_;
   std::map<int, ClampedRunningMean<7>> fused_;        // the network's (kd, ks, alpha)
   std::map<int, WeightedRunningMean<4>> fused_lobe_;  // the fits' (ks, alpha)
+  std::map<int, ClampedRunningMean<3>> fused_refined_kd_;
 };
 
 }  // namespace glint::reflectance

@@ -1,10 +1,12 @@
-// Re-rendering: Ward shading under point lights against the formula, and the refined albedo's
-// interpolation between observation voxels of one segment.
+// Re-rendering: Ward shading under point lights against the formula, the refined albedo's
+// interpolation between observation voxels of one segment, and the segment's refined albedo
+// where no voxel around has one.
 #include "reflectance/material_maps.h"
 
 #include <gtest/gtest.h>
 
 #include "fusion/integrate.h"
+#include "reflectance/segment_map.h"
 
 namespace glint::reflectance {
 namespace {
@@ -50,6 +52,8 @@ class Wall {
     return grid_;
   }
   std::size_t voxels() const { return visible_.size(); }
+  ObservationGrid& grid() { return grid_; }
+  const std::vector<VisibleVoxel>& visible() const { return visible_; }
 
  private:
   static fusion::VolumeParams volume_params() {
@@ -129,6 +133,44 @@ TEST(MaterialMaps, RefinedAlbedoInterpolatesWithinTheSegmentOnly) {
   ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, kd));
   EXPECT_NEAR(kd.x(), 0.5f + p.x(), 5e-3f);
   EXPECT_FALSE(interpolate_refined_kd(grid, p, 4, kd)) << "another segment's voxels are not used";
+}
+
+TEST(MaterialMaps, WithoutRefinedVoxelsAroundThePointTheSegmentsFusedRefinedAlbedoStands) {
+  Wall wall;
+  ObservationGrid& grid = wall.grid();
+  SegmentMap segments;
+  segments.update(grid, wall.visible(), Image<std::int32_t>(80, 60, 1, 3), true);
+  const HemiCnn network;  // zero weights: some material, not this test's concern
+  SpecularParams params;
+  params.min_observations = 1;
+  params.fit_lobe = false;
+  SpecularEstimator estimator(network, params);
+  std::vector<render::PointLight> lights(1);
+  lights[0].position = {0, 0, 0};
+  estimator.update(grid, segments, segments.frame_segments(), lights, 0);
+  ASSERT_NE(estimator.material(3), nullptr);
+  EXPECT_FALSE(estimator.material(3)->kd_refined);
+
+  // Fused with the clamped running mean; a segment without a material ignores it.
+  estimator.fuse_refined_albedo(3, {0.4f, 0.3f, 0.2f});
+  estimator.fuse_refined_albedo(3, {0.6f, 0.5f, 0.4f});
+  estimator.fuse_refined_albedo(7, {1.0f, 1.0f, 1.0f});
+  EXPECT_EQ(estimator.material(7), nullptr);
+  ASSERT_TRUE(estimator.material(3)->kd_refined);
+  const Eigen::Vector3f segment_kd(0.5f, 0.4f, 0.3f);
+  EXPECT_TRUE(estimator.material(3)->kd_refined->isApprox(segment_kd, 1e-6f));
+
+  // No voxel has a refined albedo: the segment's, beside the network's unrefined one.
+  const Eigen::Vector3f p(0.013f, -0.007f, 1.005f);
+  PointMaterial material;
+  ASSERT_TRUE(material_at(grid, estimator, p, material));
+  EXPECT_EQ(material.segment, 3);
+  EXPECT_TRUE(material.refined.kd.isApprox(segment_kd, 1e-6f));
+  EXPECT_TRUE(material.fused.kd.isApprox(estimator.material(3)->ward.kd));
+  // Voxels around p with one: theirs.
+  wall.with_albedo([](const Eigen::Vector3f&) { return Eigen::Vector3f::Constant(0.7f); });
+  ASSERT_TRUE(material_at(grid, estimator, p, material));
+  EXPECT_TRUE(material.refined.kd.isApprox(Eigen::Vector3f::Constant(0.7f), 1e-6f));
 }
 
 }  // namespace
