@@ -77,7 +77,7 @@ bool blend_without_outliers(const WeightedAlbedos& around, Eigen::Vector3f& kd) 
 }  // namespace
 
 bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& p, int segment,
-                            Eigen::Vector3f& kd) {
+                            Eigen::Vector3f& kd, bool unreliable_corners) {
   // Voxel centres sit at (i + 0.5) * size: the 8 around p start at floor(p / size - 0.5).
   const Eigen::Vector3f g = p / float(grid.params().voxel_size_m) - Eigen::Vector3f::Constant(0.5f);
   const Eigen::Vector3i base(int(std::floor(g.x())), int(std::floor(g.y())),
@@ -107,6 +107,7 @@ bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& 
           reliable.add(weight, grid.refined_kd(v));
         }
   }
+  if (reliable.count == 0 && !unreliable_corners) return false;
   return blend_without_outliers(reliable.count > 0 ? reliable : unreliable, kd);
 }
 
@@ -143,7 +144,7 @@ bool material_at(const ObservationGrid& grid, const SpecularEstimator& materials
   if (!fused) return false;
   material.fused = material.refined = fused->ward;
   if (fused->kd_refined) material.refined.kd = *fused->kd_refined;
-  interpolate_refined_kd(grid, p, material.segment, material.refined.kd);
+  interpolate_refined_kd(grid, p, material.segment, material.refined.kd, !fused->kd_refined);
   return true;
 }
 

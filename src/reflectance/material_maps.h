@@ -36,17 +36,18 @@ Eigen::Vector3f shade_ward(const render::WardMaterial& material, const Eigen::Ve
 // of `segment` with a refined albedo, and of those to the reliable ones (solved under light
 // that is not grazing, ObservationGrid::refined_kd_reliable) where there are any; with none
 // reliable, the reliable voxels of the 4^3 around p under a tent of twice the width, and only
-// without those the unreliable corners. Less a minority of outliers (at most a quarter of four
-// or more, mean albedo off their median by more than kRefinedKdOutlier of it), renormalised;
-// false when there is none.
+// without those the unreliable corners (when `unreliable_corners`: a caller with a better
+// albedo for p, such as the segment's refined one, keeps its own). Less a minority of outliers
+// (at most a quarter of four or more, mean albedo off their median by more than
+// kRefinedKdOutlier of it), renormalised; false when there is none.
 inline constexpr float kRefinedKdOutlier = 0.5f;
 bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& p, int segment,
-                            Eigen::Vector3f& kd);
+                            Eigen::Vector3f& kd, bool unreliable_corners = true);
 
 // The material at surface point p: the segment of the voxel holding p (else of the nearest
 // labelled neighbour voxel), its fused Ward parameters, and the same with the refined kd (the
-// segment's fused refined kd where interpolate_refined_kd finds none; the network's before
-// the segment has one).
+// segment's fused refined kd where interpolate_refined_kd finds no reliable voxel; before the
+// segment has one, the unreliable voxels around p, else the network's kd).
 // False when p lies in no segment with a material yet.
 struct PointMaterial {
   int segment = 0;

@@ -171,6 +171,11 @@ TEST(MaterialMaps, WithoutRefinedVoxelsAroundThePointTheSegmentsFusedRefinedAlbe
   wall.with_albedo([](const Eigen::Vector3f&) { return Eigen::Vector3f::Constant(0.7f); });
   ASSERT_TRUE(material_at(grid, estimator, p, material));
   EXPECT_TRUE(material.refined.kd.isApprox(Eigen::Vector3f::Constant(0.7f), 1e-6f));
+  // Only unreliable ones (grazing light) anywhere: the segment's again.
+  wall.with_albedo([](const Eigen::Vector3f&) { return Eigen::Vector3f::Constant(0.95f); },
+                   [](const Eigen::Vector3f&) { return false; });
+  ASSERT_TRUE(material_at(grid, estimator, p, material));
+  EXPECT_TRUE(material.refined.kd.isApprox(segment_kd, 1e-6f));
 }
 
 }  // namespace
