@@ -6,7 +6,9 @@
 // With fit_lobe (glint's addition, reflectance/specular_fit.h) a photometric fit of the Ward
 // lobe to the same voxels' observations also runs; where it explains them, its ks and alpha
 // are fused separately, each weighted by how well it explains the observations, and replace
-// the network's once the segment has min_fits of them. kd is always the network's.
+// the network's once the segment has min_fits of them. kd is always the network's; the albedo
+// stage's refined kd per segment is fused beside it (fuse_refined_albedo), for the
+// re-renderings to fall back on.
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -69,9 +71,9 @@ class SpecularEstimator {
   SpecularParams params_;
   HemiImageParams hemi_;
   std::map<int, SegmentMaterial> materials_;
-  std::map<int, ClampedRunningMean<7>> fused_;        // the network's (kd, ks, alpha)
-  std::map<int, WeightedRunningMean<4>> fused_lobe_;  // the fits' (ks, alpha)
-  std::map<int, ClampedRunningMean<3>> fused_refined_kd_;
+  std::map<int, ClampedRunningMean<7>> fused_;             // the network's (kd, ks, alpha)
+  std::map<int, WeightedRunningMean<4>> fused_lobe_;       // the fits' (ks, alpha)
+  std::map<int, ClampedRunningMean<3>> fused_refined_kd_;  // the albedo stage's per-frame means
 };
 
 }  // namespace glint::reflectance
