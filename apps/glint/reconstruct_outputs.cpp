@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <map>
 
+#include "core/parallel.h"
 #include "fusion/marching_cubes.h"
 #include "io/image_io.h"
 #include "io/json_report.h"
@@ -51,12 +52,12 @@ void write_material_mesh(const std::string& path,
   std::array<std::vector<float>, 8> values;  // kd rgb, ks rgb, alpha, segment
   for (auto& v : values) v.assign(n, 0.0f);
   mesh.colours.assign(n, Eigen::Vector3f::Zero());
-  for (std::size_t i = 0; i < n; ++i) {
+  parallel_for(n, [&](std::size_t i) {
     reflectance::PointMaterial material;
     if (!reflectance::material_at(pipeline.observations(), pipeline.materials(), mesh.vertices[i],
                                   material)) {
       values[7][i] = float(material.segment);
-      continue;
+      return;
     }
     mesh.colours[i] = material.refined.kd;
     for (int c = 0; c < 3; ++c) {
@@ -65,7 +66,7 @@ void write_material_mesh(const std::string& path,
     }
     values[6][i] = material.fused.alpha;
     values[7][i] = float(material.segment);
-  }
+  });
   const std::array<const char*, 8> names{"kd_r", "kd_g", "kd_b",  "ks_r",
                                          "ks_g", "ks_b", "alpha", "scalar_segment"};
   for (int k = 0; k < 8; ++k) mesh.vertex_properties.emplace_back(names[k], std::move(values[k]));

@@ -1,140 +1,196 @@
 #include "fusion/marching_cubes.h"
 
-#include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_sort.h>
+#include <fmt/format.h>
 
-#include <algorithm>
 #include <array>
+#include <bit>
+#include <climits>
+#include <cmath>
+#include <cstdint>
+#include <limits>
 
+#include "core/error.h"
 #include "core/parallel.h"
 #include "fusion/marching_cubes_table.h"
 
 namespace glint::fusion {
 namespace {
 
-// A vertex is identified by the voxel edge it lies on: the edge's lower voxel (global voxel
-// coordinates, 20 bits each, offset 2^19) and its axis.
-std::uint64_t edge_key(const Eigen::Vector3i& voxel, int axis) {
-  constexpr int offset = 1 << 19;
-  return (static_cast<std::uint64_t>(voxel.x() + offset) << 42) |
-         (static_cast<std::uint64_t>(voxel.y() + offset) << 22) |
-         (static_cast<std::uint64_t>(voxel.z() + offset) << 2) | static_cast<std::uint64_t>(axis);
-}
+// A block's voxels and those of its +x/+y/+z neighbours: local coordinates in [0, 8] per axis.
+constexpr int kSide = kBlockSide + 1;
+constexpr int kEdgeBits = 3 * kVoxelsPerBlock;  // bit 3 * voxel + axis: the edge towards +axis
+constexpr int kEdgeWords = kEdgeBits / 64;
 
-// Read access to the voxels of a block and of its +x/+y/+z neighbours: local coordinates in
-// [0, 8] on each axis.
+constexpr int local_index(int x, int y, int z) { return (z * kSide + y) * kSide + x; }
+
+// Which of a block's voxel edges carry a vertex, and the set bits before each word: a vertex's
+// index within its block is then a popcount, so no pass has to search for the vertices of the
+// triangles that reach into a neighbouring block.
+struct BlockEdges {
+  std::array<std::uint64_t, kEdgeWords> bits{};
+  std::array<std::uint16_t, kEdgeWords> before{};
+  int vertices = 0;
+  int triangles = 0;
+
+  int index_of(int bit) const {
+    const int word = bit >> 6;
+    const std::uint64_t lower = (std::uint64_t{1} << (bit & 63)) - 1;
+    return before[std::size_t(word)] + std::popcount(bits[std::size_t(word)] & lower);
+  }
+};
+
 class BlockNeighbourhood {
  public:
   BlockNeighbourhood(const TsdfVolume& volume, int block) : volume_(volume) {
     const Eigen::Vector3i coordinates = volume.hash().block(block);
     for (int n = 0; n < 8; ++n)
-      blocks_[n] =
+      blocks_[std::size_t(n)] =
           volume.hash().find(coordinates + Eigen::Vector3i(n & 1, (n >> 1) & 1, (n >> 2) & 1));
+    // Each voxel is read once here instead of once per edge and cube corner it belongs to.
+    constexpr float unobserved = std::numeric_limits<float>::quiet_NaN();
+    for (int z = 0; z < kSide; ++z)
+      for (int y = 0; y < kSide; ++y)
+        for (int x = 0; x < kSide; ++x) {
+          const int owner = block_of(x, y, z);
+          const int voxel = voxel_in_block(x, y, z);
+          sdf_[std::size_t(local_index(x, y, z))] = owner >= 0 && volume.weight(owner)[voxel] > 0
+                                                        ? volume.sdf_m(owner)[voxel]
+                                                        : unobserved;
+        }
   }
-  // False when the voxel is unobserved (absent block or weight 0).
-  bool get(int x, int y, int z, float& sdf) const {
-    const int block = blocks_[(x >> 3) | ((y >> 3) << 1) | ((z >> 3) << 2)];
-    if (block < 0) return false;
-    const int voxel = voxel_in_block(x, y, z);
-    if (volume_.weight(block)[voxel] <= 0) return false;
-    sdf = volume_.sdf_m(block)[voxel];
-    return true;
+  // The pool index of the block holding local voxel (x, y, z), -1 where none is allocated.
+  int block_of(int x, int y, int z) const {
+    return blocks_[std::size_t((x >> 3) | ((y >> 3) << 1) | ((z >> 3) << 2))];
   }
+  // NaN where unobserved (absent block or weight 0).
+  float sdf(int x, int y, int z) const { return sdf_[std::size_t(local_index(x, y, z))]; }
   Eigen::Vector3f colour(int x, int y, int z) const {
     if (!volume_.has_colour()) return Eigen::Vector3f::Zero();
-    const int block = blocks_[(x >> 3) | ((y >> 3) << 1) | ((z >> 3) << 2)];
+    const int block = block_of(x, y, z);
     const int voxel = voxel_in_block(x, y, z);
     return {volume_.red(block)[voxel], volume_.green(block)[voxel], volume_.blue(block)[voxel]};
+  }
+  // The marching-cubes case of the cube whose lowest corner is voxel (x, y, z) (x, y, z < 8),
+  // -1 where a corner is unobserved.
+  int configuration(int x, int y, int z) const {
+    int configuration = 0;
+    for (int c = 0; c < 8; ++c) {
+      const float s = sdf(x + (c & 1), y + ((c >> 1) & 1), z + ((c >> 2) & 1));
+      if (std::isnan(s)) return -1;
+      if (s < 0) configuration |= 1 << c;
+    }
+    return configuration;
   }
 
  private:
   const TsdfVolume& volume_;
   std::array<int, 8> blocks_;
+  std::array<float, kSide * kSide * kSide> sdf_;
 };
 
-struct MeshPiece {
-  std::vector<std::uint64_t> vertex_keys;
-  std::vector<Eigen::Vector3f> vertices;
-  std::vector<Eigen::Vector3f> colours;
-  std::vector<std::array<std::uint64_t, 3>> triangles;
-};
+// Does the edge from local voxel (x, y, z) towards +axis cross the surface?
+bool edge_has_vertex(const BlockNeighbourhood& voxels, int x, int y, int z, int axis) {
+  const float sdf0 = voxels.sdf(x, y, z);
+  const float sdf1 = voxels.sdf(x + (axis == 0), y + (axis == 1), z + (axis == 2));
+  return !std::isnan(sdf0) && !std::isnan(sdf1) && (sdf0 < 0) != (sdf1 < 0);
+}
 
-void extract_block(const TsdfVolume& volume, int block, MeshPiece& piece) {
+BlockEdges count_block(const TsdfVolume& volume, int block) {
+  const BlockNeighbourhood voxels(volume, block);
+  const auto& cases = marching_cubes_cases();
+  BlockEdges edges;
+  for (int z = 0; z < kBlockSide; ++z)
+    for (int y = 0; y < kBlockSide; ++y)
+      for (int x = 0; x < kBlockSide; ++x) {
+        const int bit = 3 * voxel_in_block(x, y, z);
+        for (int axis = 0; axis < 3; ++axis)
+          if (edge_has_vertex(voxels, x, y, z, axis))
+            edges.bits[std::size_t((bit + axis) >> 6)] |= std::uint64_t{1} << ((bit + axis) & 63);
+        const int configuration = voxels.configuration(x, y, z);
+        if (configuration >= 0) edges.triangles += cases[std::size_t(configuration)].triangle_count;
+      }
+  for (int word = 0; word < kEdgeWords; ++word) {
+    edges.before[std::size_t(word)] = std::uint16_t(edges.vertices);
+    edges.vertices += std::popcount(edges.bits[std::size_t(word)]);
+  }
+  return edges;
+}
+
+// Writes the block's vertices from vertex_begin[block] and its triangles from
+// triangle_begin[block]; a triangle's vertex on another block's edge is found through that
+// block's edge bits.
+void extract_block(const TsdfVolume& volume, int block, const std::vector<BlockEdges>& edges,
+                   const std::vector<int>& vertex_begin, const std::vector<int>& triangle_begin,
+                   TriangleMesh& mesh) {
   const BlockNeighbourhood voxels(volume, block);
   const Eigen::Vector3i first_voxel = volume.hash().block(block) * kBlockSide;
   const float voxel_size = static_cast<float>(volume.params().voxel_size_m);
   const auto& cases = marching_cubes_cases();
-  for (int z = 0; z < kBlockSide; ++z) {
-    for (int y = 0; y < kBlockSide; ++y) {
+  const BlockEdges& own = edges[std::size_t(block)];
+  int vertex = vertex_begin[std::size_t(block)];
+  for (int word = 0; word < kEdgeWords; ++word)
+    for (std::uint64_t bits = own.bits[std::size_t(word)]; bits != 0; bits &= bits - 1) {
+      const int bit = word * 64 + std::countr_zero(bits);
+      const int v = bit / 3, axis = bit % 3;
+      const int x = v % kBlockSide, y = v / kBlockSide % kBlockSide,
+                z = v / (kBlockSide * kBlockSide);
+      const int x1 = x + (axis == 0), y1 = y + (axis == 1), z1 = z + (axis == 2);
+      const float sdf0 = voxels.sdf(x, y, z);
+      const float t = sdf0 / (sdf0 - voxels.sdf(x1, y1, z1));
+      Eigen::Vector3f position =
+          (first_voxel + Eigen::Vector3i(x, y, z)).cast<float>() * voxel_size;
+      position[axis] += t * voxel_size;
+      mesh.vertices[std::size_t(vertex)] = position;
+      mesh.colours[std::size_t(vertex)] =
+          (1 - t) * voxels.colour(x, y, z) + t * voxels.colour(x1, y1, z1);
+      ++vertex;
+    }
+  int triangle = triangle_begin[std::size_t(block)];
+  for (int z = 0; z < kBlockSide; ++z)
+    for (int y = 0; y < kBlockSide; ++y)
       for (int x = 0; x < kBlockSide; ++x) {
-        float sdf0;
-        if (!voxels.get(x, y, z, sdf0)) continue;
-        const Eigen::Vector3i voxel = first_voxel + Eigen::Vector3i(x, y, z);
-        // Vertices on the three edges this voxel owns (towards +x, +y, +z).
-        for (int axis = 0; axis < 3; ++axis) {
-          const Eigen::Vector3i other = Eigen::Vector3i(x, y, z) + Eigen::Vector3i::Unit(axis);
-          float sdf1;
-          if (!voxels.get(other.x(), other.y(), other.z(), sdf1) || (sdf0 < 0) == (sdf1 < 0))
-            continue;
-          const float t = sdf0 / (sdf0 - sdf1);
-          Eigen::Vector3f position = voxel.cast<float>() * voxel_size;
-          position[axis] += t * voxel_size;
-          piece.vertex_keys.push_back(edge_key(voxel, axis));
-          piece.vertices.push_back(position);
-          piece.colours.push_back((1 - t) * voxels.colour(x, y, z) +
-                                  t * voxels.colour(other.x(), other.y(), other.z()));
-        }
-        // Triangles of the cube whose lowest corner is this voxel.
-        int configuration = 0;
-        bool observed = true;
-        for (int c = 0; c < 8 && observed; ++c) {
-          float sdf;
-          observed = voxels.get(x + (c & 1), y + ((c >> 1) & 1), z + ((c >> 2) & 1), sdf);
-          if (observed && sdf < 0) configuration |= 1 << c;
-        }
-        if (!observed) continue;
-        const CubeCase& cube = cases[configuration];
+        const int configuration = voxels.configuration(x, y, z);
+        if (configuration < 0) continue;
+        const CubeCase& cube = cases[std::size_t(configuration)];
         for (int t = 0; t < cube.triangle_count; ++t) {
-          std::array<std::uint64_t, 3> triangle;
+          Eigen::Vector3i& indices = mesh.triangles[std::size_t(triangle++)];
           for (int k = 0; k < 3; ++k) {
             const CubeEdge& edge = kCubeEdges[cube.edges[3 * t + k]];
-            const Eigen::Vector3i corner(edge.corner & 1, (edge.corner >> 1) & 1,
-                                         (edge.corner >> 2) & 1);
-            triangle[k] = edge_key(voxel + corner, edge.axis);
+            const int ox = x + (edge.corner & 1), oy = y + ((edge.corner >> 1) & 1),
+                      oz = z + ((edge.corner >> 2) & 1);
+            const int owner = voxels.block_of(ox, oy, oz);
+            indices[k] =
+                vertex_begin[std::size_t(owner)] +
+                edges[std::size_t(owner)].index_of(3 * voxel_in_block(ox, oy, oz) + edge.axis);
           }
-          piece.triangles.push_back(triangle);
         }
       }
-    }
-  }
 }
 
 }  // namespace
 
 TriangleMesh extract_mesh(const TsdfVolume& volume) {
-  tbb::enumerable_thread_specific<MeshPiece> pieces;
-  parallel_for(volume.block_count(), [&](std::size_t block) {
-    extract_block(volume, static_cast<int>(block), pieces.local());
-  });
+  const std::size_t blocks = volume.block_count();
+  std::vector<BlockEdges> edges(blocks);
+  parallel_for(blocks, [&](std::size_t block) { edges[block] = count_block(volume, int(block)); });
 
-  TriangleMesh mesh;
-  std::vector<std::pair<std::uint64_t, int>> index_of_key;
-  std::vector<std::array<std::uint64_t, 3>> triangle_keys;
-  for (const MeshPiece& piece : pieces) {
-    for (std::size_t i = 0; i < piece.vertices.size(); ++i)
-      index_of_key.push_back({piece.vertex_keys[i], static_cast<int>(mesh.vertices.size() + i)});
-    mesh.vertices.insert(mesh.vertices.end(), piece.vertices.begin(), piece.vertices.end());
-    mesh.colours.insert(mesh.colours.end(), piece.colours.begin(), piece.colours.end());
-    triangle_keys.insert(triangle_keys.end(), piece.triangles.begin(), piece.triangles.end());
+  std::vector<int> vertex_begin(blocks), triangle_begin(blocks);
+  std::int64_t vertices = 0, triangles = 0;
+  for (std::size_t block = 0; block < blocks; ++block) {
+    vertex_begin[block] = int(vertices);
+    triangle_begin[block] = int(triangles);
+    vertices += edges[block].vertices;
+    triangles += edges[block].triangles;
+    if (vertices > INT_MAX || triangles > INT_MAX)
+      throw Error("marching cubes", "",
+                  fmt::format("the mesh would have over {} vertices or triangles", INT_MAX));
   }
-  tbb::parallel_sort(index_of_key.begin(), index_of_key.end());
-  mesh.triangles.resize(triangle_keys.size());
-  parallel_for(triangle_keys.size(), [&](std::size_t t) {
-    for (int k = 0; k < 3; ++k) {
-      const auto found = std::lower_bound(index_of_key.begin(), index_of_key.end(),
-                                          std::pair<std::uint64_t, int>{triangle_keys[t][k], -1});
-      mesh.triangles[t][k] = found->second;
-    }
+  TriangleMesh mesh;
+  mesh.vertices.resize(std::size_t(vertices));
+  mesh.colours.resize(std::size_t(vertices));
+  mesh.triangles.resize(std::size_t(triangles));
+  parallel_for(blocks, [&](std::size_t block) {
+    extract_block(volume, int(block), edges, vertex_begin, triangle_begin, mesh);
   });
   return mesh;
 }

@@ -3,7 +3,8 @@
 // allocated blocks, in parallel. Cubes span 8 neighbouring voxels (across block borders); a
 // cube with an unobserved corner (weight 0) emits nothing. Each mesh vertex sits on a voxel
 // edge, linearly interpolated between the two SDF values, and is shared by all triangles using
-// that edge, so a closed surface gives a closed mesh.
+// that edge, so a closed surface gives a closed mesh. Vertices and triangles come in block order,
+// the same for any number of threads.
 #include "fusion/triangle_mesh.h"
 #include "fusion/tsdf_volume.h"
 

@@ -3,12 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <numbers>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "fusion/marching_cubes_table.h"
 #include "fusion_test_support.h"
 
@@ -61,6 +63,25 @@ TEST(MarchingCubes, SphereAreaAndVolumeWithinOnePercent) {
   }
 }
 
+TEST(MarchingCubes, TheMeshIsTheSameWhateverTheThreadCount) {
+  VolumeParams params;
+  params.voxel_size_m = 0.01;
+  params.block_capacity = 20000;
+  TsdfVolume volume(params);
+  test::fill_analytic(
+      volume, [](const Eigen::Vector3d& p) { return p.norm() - 0.25; }, 0.3, 0.04);
+  const TriangleMesh parallel = extract_mesh(volume);
+  TriangleMesh serial;
+  {
+    const auto one_thread = limit_threads(1);
+    serial = extract_mesh(volume);
+  }
+  ASSERT_GT(parallel.vertices.size(), 1000u);
+  EXPECT_EQ(parallel.vertices, serial.vertices);
+  EXPECT_EQ(parallel.colours, serial.colours);
+  EXPECT_EQ(parallel.triangles, serial.triangles);
+}
+
 TEST(MarchingCubes, UnobservedVoxelsEmitNothing) {
   TsdfVolume volume;
   EXPECT_TRUE(extract_mesh(volume).triangles.empty());
@@ -85,6 +106,37 @@ TEST(MarchingCubes, PlyOutputHasHeaderCountsAndColours) {
   EXPECT_EQ(text.size() - body, 3 * 15 + 13u);
   EXPECT_EQ(linear_to_srgb8(1.0f), 255);
   EXPECT_EQ(linear_to_srgb8(0.2158605f), 128);
+}
+
+TEST(MarchingCubes, PlyRecordsPastTheFirstWriteChunkKeepTheirOrder) {
+  // More vertices and faces than one packing chunk (2^16 records).
+  TriangleMesh mesh;
+  const int n = 70000;
+  for (int i = 0; i < n; ++i) mesh.vertices.emplace_back(float(i), float(-i), 0.5f * float(i));
+  mesh.vertex_properties.emplace_back("index", std::vector<float>(std::size_t(n)));
+  for (int i = 0; i < n; ++i) mesh.vertex_properties[0].second[std::size_t(i)] = float(i);
+  for (int i = 0; i + 2 < n; ++i) mesh.triangles.emplace_back(i, i + 1, i + 2);
+  const std::string path = ::testing::TempDir() + "/chunked.ply";
+  write_mesh_ply(path, mesh);
+  std::ifstream in(path, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), {});
+  const std::size_t body = text.find("end_header\n") + 11;
+  ASSERT_EQ(text.size() - body, std::size_t(n) * 16 + std::size_t(n - 2) * 13);
+  for (const int i : {0, 65535, 65536, n - 1}) {
+    float record[4];
+    std::memcpy(record, text.data() + body + std::size_t(i) * 16, sizeof(record));
+    EXPECT_EQ(record[0], float(i));
+    EXPECT_EQ(record[1], float(-i));
+    EXPECT_EQ(record[3], float(i));
+  }
+  for (const int t : {0, 65536, n - 3}) {
+    const char* face = text.data() + body + std::size_t(n) * 16 + std::size_t(t) * 13;
+    int indices[3];
+    std::memcpy(indices, face + 1, sizeof(indices));
+    EXPECT_EQ(face[0], 3);
+    EXPECT_EQ(indices[0], t);
+    EXPECT_EQ(indices[2], t + 2);
+  }
 }
 
 TEST(MarchingCubes, PlyHeaderCarriesTheCommentsAndRefusesAMultiLineOne) {
