@@ -13,7 +13,9 @@
 int main(int argc, char** argv) {
   CLI::App app{
       "glint - practical real-time reflectance estimation toolkit.\n"
-      "Point-cloud edge/boundary detection (BoundED) and locally-guided image denoising.\n"
+      "Online reflectance reconstruction from RGB-D (fuse, lights, reconstruct, hemicnn;\n"
+      "render and synth make synthetic sequences with ground truth), locally-guided image\n"
+      "denoising (denoise) and point-cloud edge/boundary detection (edges, BoundED).\n"
       "Run 'glint <command> --help' for the options of each command."};
   app.require_subcommand(1);
   app.set_version_flag("--version", "glint 0.1.0");
