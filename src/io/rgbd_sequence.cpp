@@ -1,6 +1,7 @@
 #include "io/rgbd_sequence.h"
 
 #include <fmt/format.h>
+#include <tbb/parallel_invoke.h>
 
 #include <array>
 #include <cmath>
@@ -113,8 +114,9 @@ RgbdFrame read_rgbd_frame(const RgbdSequence& sequence, std::size_t i) {
   frame.index = i;
   frame.timestamp_s = files.timestamp_s;
   frame.ground_truth = files.ground_truth;
-  frame.depth_m = read_depth(files.depth_path, sequence);
-  frame.colour = read_colour(files.colour_path, sequence);
+  // The two PNG decodes run side by side: reading was as long as a frame's fusion on 7-Scenes.
+  tbb::parallel_invoke([&] { frame.depth_m = read_depth(files.depth_path, sequence); },
+                       [&] { frame.colour = read_colour(files.colour_path, sequence); });
   return frame;
 }
 
