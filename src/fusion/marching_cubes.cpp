@@ -16,7 +16,7 @@
 namespace glint::fusion {
 namespace {
 
-// A block's voxels and those of its +x/+y/+z neighbours: local coordinates in [0, 8] per axis.
+// Voxels per side of a block with its +x/+y/+z neighbours' first layers.
 constexpr int kSide = kBlockSide + 1;
 constexpr int kEdgeBits = 3 * kVoxelsPerBlock;  // bit 3 * voxel + axis: the edge towards +axis
 constexpr int kEdgeWords = kEdgeBits / 64;
@@ -39,6 +39,8 @@ struct BlockEdges {
   }
 };
 
+// Read access to the voxels of a block and of its +x/+y/+z neighbours (local coordinates in
+// [0, 8] on each axis), their distances copied once.
 class BlockNeighbourhood {
  public:
   BlockNeighbourhood(const TsdfVolume& volume, int block) : volume_(volume) {
