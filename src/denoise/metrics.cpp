@@ -1,11 +1,10 @@
 #include "denoise/metrics.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
-#include <opencv2/core.hpp>
-#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
@@ -50,40 +49,83 @@ bool selected(const ImageF* mask, std::size_t i) {
   return mask == nullptr || mask->values()[i] > 0.5f;
 }
 
-// Wang et al.'s window: 11×11 Gaussian, σ = 1.5.
-constexpr int kWindow = 11;
+// Wang et al.'s window: 11×11 Gaussian, σ = 1.5, separable.
+constexpr int kRadius = 5;
+constexpr int kWindow = 2 * kRadius + 1;
 constexpr double kSigma = 1.5;
 
-// Windowed mean of `plane` at every pixel; at the borders over the part of the window inside
-// the image, renormalised (zero padding divided by the window weight inside the image).
-class WindowMean {
- public:
-  WindowMean(int width, int height)
-      : kernel_(cv::getGaussianKernel(kWindow, kSigma, CV_64F)),
-        weight_(filter(cv::Mat::ones(height, width, CV_64F))) {}
-  cv::Mat operator()(const cv::Mat& plane) const { return filter(plane) / weight_; }
+std::array<double, kWindow> gaussian_taps() {
+  std::array<double, kWindow> taps{};
+  for (int i = 0; i < kWindow; ++i)
+    taps[std::size_t(i)] = std::exp(-double((i - kRadius) * (i - kRadius)) / (2 * kSigma * kSigma));
+  const double sum = std::accumulate(taps.begin(), taps.end(), 0.0);
+  for (double& tap : taps) tap /= sum;
+  return taps;
+}
 
- private:
-  cv::Mat filter(const cv::Mat& plane) const {
-    cv::Mat out;
-    cv::sepFilter2D(plane, out, CV_64F, kernel_, kernel_, cv::Point(-1, -1), 0,
-                    cv::BORDER_CONSTANT);
-    return out;
-  }
-  cv::Mat kernel_;
-  cv::Mat weight_;
-};
+// The five windowed moments at a pixel: means of x, y, x², y², xy.
+constexpr int kMoments = 5;
 
-// The SSIM map of one channel (Wang et al. 2004).
-cv::Mat ssim_map(const cv::Mat& x, const cv::Mat& y, const WindowMean& mean) {
+// Sum of the taps of the window centred on i that fall inside [0, n): dividing by it
+// renormalises the window where it is cut by the border.
+double inside_weight(const std::array<double, kWindow>& taps, int i, int n) {
+  double weight = 0;
+  for (int k = std::max(0, i - kRadius); k <= std::min(n - 1, i + kRadius); ++k)
+    weight += taps[std::size_t(k - i + kRadius)];
+  return weight;
+}
+
+// Sum of the SSIM map of one channel over the selected pixels. The moments are filtered
+// row by row (horizontal pass into a ring of 11 rows, then the vertical pass), in doubles and
+// without whole-image temporaries: with those, a frame's evaluation spent most of its time in
+// page faults.
+double ssim_sum(const float* x, const float* y, int width, int height, const ImageF* mask) {
   constexpr double c1 = 0.01 * 0.01, c2 = 0.03 * 0.03;  // (K1 L)², (K2 L)², L = 1
-  const cv::Mat mx = mean(x), my = mean(y);
-  const cv::Mat mxx = mx.mul(mx), myy = my.mul(my), mxy = mx.mul(my);
-  const cv::Mat vx = mean(x.mul(x)) - mxx, vy = mean(y.mul(y)) - myy;
-  const cv::Mat cxy = mean(x.mul(y)) - mxy;
-  cv::Mat numerator = (2 * mxy + c1).mul(2 * cxy + c2);
-  cv::Mat denominator = (mxx + myy + c1).mul(vx + vy + c2);
-  return numerator / denominator;
+  static const std::array<double, kWindow> taps = gaussian_taps();
+  std::vector<double> column_weight(std::size_t(width), 0.0);
+  for (int c = 0; c < width; ++c) column_weight[std::size_t(c)] = inside_weight(taps, c, width);
+  // ring[(row % kWindow)][moment][column]: a row's horizontally filtered moments.
+  const std::size_t row_size = std::size_t(kMoments) * std::size_t(width);
+  std::vector<double> ring(kWindow * row_size);
+  const auto filter_row = [&](int row) {
+    double* out = ring.data() + std::size_t(row % kWindow) * row_size;
+    const float* xr = x + std::size_t(row) * std::size_t(width);
+    const float* yr = y + std::size_t(row) * std::size_t(width);
+    for (int c = 0; c < width; ++c) {
+      double m[kMoments] = {};
+      for (int k = std::max(0, c - kRadius); k <= std::min(width - 1, c + kRadius); ++k) {
+        const double w = taps[std::size_t(k - c + kRadius)], a = xr[k], b = yr[k];
+        m[0] += w * a, m[1] += w * b, m[2] += w * a * a, m[3] += w * b * b, m[4] += w * a * b;
+      }
+      for (int j = 0; j < kMoments; ++j)
+        out[std::size_t(j) * std::size_t(width) + std::size_t(c)] =
+            m[j] / column_weight[std::size_t(c)];
+    }
+  };
+  std::vector<double> moments(row_size);
+  double sum = 0;
+  int next_filtered = 0;
+  for (int row = 0; row < height; ++row) {
+    const int first = std::max(0, row - kRadius), last = std::min(height - 1, row + kRadius);
+    for (; next_filtered <= last; ++next_filtered) filter_row(next_filtered);
+    const double row_weight = inside_weight(taps, row, height);
+    std::fill(moments.begin(), moments.end(), 0.0);
+    for (int k = first; k <= last; ++k) {
+      const double w = taps[std::size_t(k - row + kRadius)] / row_weight;
+      const double* in = ring.data() + std::size_t(k % kWindow) * row_size;
+      for (std::size_t i = 0; i < row_size; ++i) moments[i] += w * in[i];
+    }
+    for (int c = 0; c < width; ++c) {
+      if (!selected(mask, std::size_t(row) * std::size_t(width) + std::size_t(c))) continue;
+      const auto moment = [&](int j) {
+        return moments[std::size_t(j) * std::size_t(width) + std::size_t(c)];
+      };
+      const double mx = moment(0), my = moment(1);
+      const double vx = moment(2) - mx * mx, vy = moment(3) - my * my, cxy = moment(4) - mx * my;
+      sum += (2 * mx * my + c1) * (2 * cxy + c2) / ((mx * mx + my * my + c1) * (vx + vy + c2));
+    }
+  }
+  return sum;
 }
 
 }  // namespace
@@ -108,24 +150,13 @@ double psnr(const ImageF& reference, const ImageF& test, const ImageF* mask) {
 
 double ssim(const ImageF& reference, const ImageF& test, const ImageF* mask) {
   check_pair(reference, test, mask);
-  const int width = reference.width(), height = reference.height();
-  const WindowMean mean(width, height);
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < reference.pixel_count(); ++i) count += selected(mask, i);
   double total = 0;
-  for (int c = 0; c < reference.channels(); ++c) {
-    cv::Mat x, y;
-    cv::Mat(height, width, CV_32F, const_cast<float*>(reference.plane(c))).convertTo(x, CV_64F);
-    cv::Mat(height, width, CV_32F, const_cast<float*>(test.plane(c))).convertTo(y, CV_64F);
-    const cv::Mat map = ssim_map(x, y, mean);
-    const auto* values = map.ptr<double>();  // continuous: a fresh result
-    double sum = 0;
-    std::size_t count = 0;
-    for (std::size_t i = 0; i < reference.pixel_count(); ++i) {
-      if (!selected(mask, i)) continue;
-      sum += values[i];
-      ++count;
-    }
-    total += sum / static_cast<double>(count);
-  }
+  for (int c = 0; c < reference.channels(); ++c)
+    total +=
+        ssim_sum(reference.plane(c), test.plane(c), reference.width(), reference.height(), mask) /
+        static_cast<double>(count);
   return total / reference.channels();
 }
 
