@@ -1,12 +1,16 @@
 #include "reflectance/material_evaluation.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <utility>
+#include <vector>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "denoise/metrics.h"
 #include "io/image_io.h"
 #include "render/sensor.h"
@@ -188,29 +192,52 @@ void MaterialEvaluation::add_frame(int frame, const MaterialMaps& estimate,
 
   std::set<int> objects(truth.segment.values().begin(), truth.segment.values().end());
   objects.erase(0);
-  ImageF mask(width, height, 1);
+  // The objects with enough covered pixels, each with its mask and bounding box.
+  struct ObjectView {
+    int object;
+    ImageF mask;
+    Box box;
+    int covered, pixels;
+  };
+  std::vector<ObjectView> views;
   for (int object : objects) {
-    Box box{width, height, 0, 0};
-    int covered = 0, pixels = 0;
+    ObjectView entry{object, ImageF(width, height, 1), Box{width, height, 0, 0}, 0, 0};
     for (int y = 0; y < height; ++y)
       for (int x = 0; x < width; ++x) {
         const bool mine = truth.segment.at(x, y, 0) == object;
-        pixels += mine;
-        const bool scored = mine && estimate.covered.at(x, y, 0) > 0.5f;
-        mask.at(x, y, 0) = scored ? 1.0f : 0.0f;
-        if (!scored) continue;
-        ++covered;
-        box = {std::min(box.x0, x), std::min(box.y0, y), std::max(box.x1, x + 1),
-               std::max(box.y1, y + 1)};
+        entry.pixels += mine;
+        const bool covered = mine && estimate.covered.at(x, y, 0) > 0.5f;
+        entry.mask.at(x, y, 0) = covered ? 1.0f : 0.0f;
+        if (!covered) continue;
+        ++entry.covered;
+        entry.box = {std::min(entry.box.x0, x), std::min(entry.box.y0, y),
+                     std::max(entry.box.x1, x + 1), std::max(entry.box.y1, y + 1)};
       }
-    if (covered < min_pixels_) continue;
+    if (entry.covered >= min_pixels_) views.push_back(std::move(entry));
+  }
+  // (truth, estimate) per quantity, in kQuantities' order; every object and quantity is scored
+  // in parallel (the SSIMs are most of an evaluated frame's time).
+  const std::array<std::pair<const ImageF*, const ImageF*>, kQuantities.size()> pairs{{
+      {&truth.kd, &estimate.kd},
+      {&truth.kd, &estimate.kd_refined},
+      {&truth.ks, &estimate.ks},
+      {&truth.alpha, &estimate.alpha},
+      {&input_srgb, &rgb},
+      {&input_srgb, &rgb_refined},
+  }};
+  std::vector<Scores> results(views.size() * pairs.size());
+  parallel_for(results.size(), [&](std::size_t i) {
+    const ObjectView& entry = views[i / pairs.size()];
+    const auto& [true_image, estimated] = pairs[i % pairs.size()];
+    results[i] = score(*true_image, *estimated, entry.mask, entry.box);
+  });
+  for (std::size_t k = 0; k < views.size(); ++k) {
+    const int object = views[k].object;
+    const ImageF& mask = views[k].mask;
+    const Box& box = views[k].box;
     auto& scores = frames_[object];
-    scores[Quantity::kd].push_back(score(truth.kd, estimate.kd, mask, box));
-    scores[Quantity::kd_refined].push_back(score(truth.kd, estimate.kd_refined, mask, box));
-    scores[Quantity::ks].push_back(score(truth.ks, estimate.ks, mask, box));
-    scores[Quantity::alpha].push_back(score(truth.alpha, estimate.alpha, mask, box));
-    scores[Quantity::rgb].push_back(score(input_srgb, rgb, mask, box));
-    scores[Quantity::rgb_refined].push_back(score(input_srgb, rgb_refined, mask, box));
+    for (std::size_t q = 0; q < pairs.size(); ++q)
+      scores[kQuantities[q]].push_back(results[k * pairs.size() + q]);
 
     Sample sample;
     sample.frame = frame;
@@ -224,7 +251,7 @@ void MaterialEvaluation::add_frame(int frame, const MaterialMaps& estimate,
     sample.true_ks = masked_mean(truth.ks, 0, mask, box);
     sample.true_alpha = masked_mean(truth.alpha, 0, mask, box);
     sample.true_rgb = masked_mean(input_srgb, 0, mask, box);
-    sample.coverage = double(covered) / pixels;
+    sample.coverage = double(views[k].covered) / views[k].pixels;
     series_[object].push_back(sample);
   }
 }
