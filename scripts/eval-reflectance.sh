@@ -10,7 +10,8 @@
 #     (orthographic, lambda 1) HemiCNN, ground-truth segmentation, both without the lobe fit;
 #   - at 1 cm observation voxels (Table 3 timings);
 #   - "fast": 1 cm geometry voxels instead of 5 mm (a CPU budget option, not the paper's).
-# Every 10th frame (and the last) is scored; about 25 minutes on 2 cores for the three scenes.
+# Every 10th frame (and the last) is scored; about 9 minutes on 2 cores for the three scenes
+# once they are rendered.
 # Reports: OUT/<scene>-<variant>/report.json; a summary table: OUT/summary.md.
 #   scripts/eval-reflectance.sh GLINT DATA [OUT] [SCENES] [FRAMES]
 set -euo pipefail
