@@ -1,12 +1,42 @@
 #include "core/progress.h"
 
+#include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace glint {
 namespace {
 std::atomic<bool> quiet_flag{false};
+
+// m:ss, or h:mm:ss from an hour on.
+std::string clock_text(double seconds) {
+  const long total = std::lround(std::max(0.0, seconds));
+  if (total >= 3600)
+    return fmt::format("{}:{:02}:{:02}", total / 3600, total / 60 % 60, total % 60);
+  return fmt::format("{}:{:02}", total / 60, total % 60);
+}
+}  // namespace
+
+std::string progress_line(const std::string& label, std::size_t done, std::size_t total,
+                          double elapsed_s) {
+  constexpr int width = 30;
+  const std::size_t shown = std::min(done, total);
+  const double fraction = total == 0 ? 1.0 : double(shown) / double(total);
+  const int filled = static_cast<int>(fraction * width);
+  std::string line = fmt::format("{} [{}{}] {:5.1f}% ({}/{}", label, std::string(filled, '#'),
+                                 std::string(width - filled, ' '), 100.0 * fraction, shown, total);
+  if (shown > 0 && elapsed_s > 0) {
+    const double rate = double(shown) / elapsed_s;
+    line += rate >= 1 ? fmt::format(", {:.1f}/s", rate) : fmt::format(", {:.1f} s each", 1 / rate);
+    line += shown < total
+                ? fmt::format(", {} left",
+                              clock_text(elapsed_s * double(total - shown) / double(shown)))
+                : fmt::format(", {}", clock_text(elapsed_s));
+  }
+  return line + ")";
 }
 
 void set_quiet(bool quiet) { quiet_flag = quiet; }
@@ -31,12 +61,10 @@ void ProgressBar::advance(std::size_t steps) {
 
 void ProgressBar::draw(std::size_t done) {
   std::lock_guard<std::mutex> lock(draw_mutex_);
-  constexpr int width = 30;
-  const double fraction = total_ == 0 ? 1.0 : std::min(1.0, double(done) / double(total_));
-  const int filled = static_cast<int>(fraction * width);
-  std::fprintf(stderr, "\r%s [%.*s%*s] %5.1f%% (%zu/%zu)", label_.c_str(), filled,
-               "##############################", width - filled, "", 100.0 * fraction,
-               std::min(done, total_), total_);
+  const double elapsed_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  // Padded: a shorter line (the rate's digits) must cover the one before it.
+  std::fprintf(stderr, "\r%-78s", progress_line(label_, done, total_, elapsed_s).c_str());
   std::fflush(stderr);
 }
 

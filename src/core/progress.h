@@ -2,6 +2,7 @@
 // A progress bar on stderr for long jobs. Silent when stderr is not a terminal or when
 // set_quiet(true) was called (the CLI's --quiet). Safe to advance from many threads.
 #include <atomic>
+#include <chrono>
 #include <cstddef>
 #include <mutex>
 #include <string>
@@ -10,6 +11,12 @@ namespace glint {
 
 void set_quiet(bool quiet);
 bool is_quiet();
+
+// The bar's line for `done` of `total` items after `elapsed_s` seconds: the bar, the count, the
+// rate and the time left (once all are done, the time taken), e.g.
+//   "fuse [#########                     ]  30.0% (15/50, 4.2/s, 0:08 left)".
+std::string progress_line(const std::string& label, std::size_t done, std::size_t total,
+                          double elapsed_s);
 
 class ProgressBar {
  public:
@@ -26,6 +33,7 @@ class ProgressBar {
 
   std::string label_;
   std::size_t total_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   std::atomic<std::size_t> done_{0};
   std::atomic<int> last_permille_{-1};
   bool enabled_;
