@@ -217,13 +217,15 @@ using BlockKernel = void (*)(const FrameConstants&, const float[3], float*, floa
   const __m512 max_weight = _mm512_set1_ps(k.max_weight);
   const __m512i width = _mm512_set1_epi32(k.width);
   const __m512i none = _mm512_set1_epi32(-1);
+  __m512 step_x[3], step_y[3];
+  for (int axis = 0; axis < 3; ++axis) {
+    step_x[axis] = _mm512_set1_ps(k.step_x[axis]);
+    step_y[axis] = _mm512_set1_ps(k.step_y[axis]);
+  }
   for (int z = 0; z < kBlockSide; ++z) {
-    __m512 slice[3], step_x[3], step_y[3];
-    for (int axis = 0; axis < 3; ++axis) {
+    __m512 slice[3];
+    for (int axis = 0; axis < 3; ++axis)
       slice[axis] = _mm512_set1_ps(origin[axis] + k.step_z[axis] * float(z));
-      step_x[axis] = _mm512_set1_ps(k.step_x[axis]);
-      step_y[axis] = _mm512_set1_ps(k.step_y[axis]);
-    }
     for (int y = 0; y < kBlockSide; y += 2) {
       const int offset = (z * kBlockSide + y) * kBlockSide;
       __builtin_prefetch(next_sdf_m + offset, 1);
@@ -254,15 +256,12 @@ using BlockKernel = void (*)(const FrameConstants&, const float[3], float*, floa
           inside & _mm512_cmp_ps_mask(d, depth_min, _CMP_GE_OQ) &
           _mm512_cmp_ps_mask(d, depth_max, _CMP_LE_OQ) &
           _mm512_cmp_ps_mask(measured, _mm512_sub_ps(_mm512_setzero_ps(), band), _CMP_GE_OQ);
-      const __m512 observation =
-          _mm512_mask_blend_ps(_mm512_cmp_ps_mask(measured, band, _CMP_LT_OQ), band, measured);
+      // vminps(a, b) is a < b ? a : b, fuse_voxel()'s clamps exactly; lanes not fused keep
+      // their voxel.
+      const __m512 observation = _mm512_maskz_min_ps(fused, measured, band);
       const __m512 total = _mm512_add_ps(w, one);
-      sdf = _mm512_mask_blend_ps(fused, sdf,
-                                 _mm512_div_ps(_mm512_fmadd_ps(sdf, w, observation), total));
-      w = _mm512_mask_blend_ps(
-          fused, w,
-          _mm512_mask_blend_ps(_mm512_cmp_ps_mask(total, max_weight, _CMP_LT_OQ), max_weight,
-                               total));
+      sdf = _mm512_mask_div_ps(sdf, fused, _mm512_fmadd_ps(sdf, w, observation), total);
+      w = _mm512_mask_min_ps(w, fused, total, max_weight);
       _mm512_storeu_ps(sdf_m + offset, sdf);
       _mm512_storeu_ps(weight + offset, w);
       _mm512_storeu_si512(fused_pixel + offset, _mm512_mask_blend_epi32(fused, none, pixel));

@@ -124,11 +124,12 @@ BlockEdges count_block(const TsdfVolume& volume, int block) {
 void extract_block(const TsdfVolume& volume, int block, const std::vector<BlockEdges>& edges,
                    const std::vector<int>& vertex_begin, const std::vector<int>& triangle_begin,
                    TriangleMesh& mesh) {
+  const BlockEdges& own = edges[std::size_t(block)];
+  if (own.vertices == 0 && own.triangles == 0) return;  // most blocks: no need to read it again
   const BlockNeighbourhood voxels(volume, block);
   const Eigen::Vector3i first_voxel = volume.hash().block(block) * kBlockSide;
   const float voxel_size = static_cast<float>(volume.params().voxel_size_m);
   const auto& cases = marching_cubes_cases();
-  const BlockEdges& own = edges[std::size_t(block)];
   int vertex = vertex_begin[std::size_t(block)];
   for (int word = 0; word < kEdgeWords; ++word)
     for (std::uint64_t bits = own.bits[std::size_t(word)]; bits != 0; bits &= bits - 1) {
