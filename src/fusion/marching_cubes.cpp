@@ -55,16 +55,15 @@ class BlockNeighbourhood {
         for (int x = 0; x < kSide; ++x) {
           const int owner = block_of(x, y, z);
           const int voxel = voxel_in_block(x, y, z);
-          sdf_[std::size_t(local_index(x, y, z))] = owner >= 0 && volume.weight(owner)[voxel] > 0
-                                                        ? volume.sdf_m(owner)[voxel]
-                                                        : unobserved;
+          const float sdf = owner >= 0 ? volume.sdf_m(owner)[voxel] : kUnobservedSdf;
+          sdf_[std::size_t(local_index(x, y, z))] = observed(sdf) ? sdf : unobserved;
         }
   }
   // The pool index of the block holding local voxel (x, y, z), -1 where none is allocated.
   int block_of(int x, int y, int z) const {
     return blocks_[std::size_t((x >> 3) | ((y >> 3) << 1) | ((z >> 3) << 2))];
   }
-  // NaN where unobserved (absent block or weight 0).
+  // NaN where unobserved (absent block or never observed).
   float sdf(int x, int y, int z) const { return sdf_[std::size_t(local_index(x, y, z))]; }
   Eigen::Vector3f colour(int x, int y, int z) const {
     if (!volume_.has_colour()) return Eigen::Vector3f::Zero();

@@ -10,10 +10,11 @@ namespace glint::fusion {
 // Weighted running average of one voxel with one projective observation (Curless & Levoy 1996;
 // VoxelHashing §4.2): measured_sdf_m = depth - z along the optical axis. Observations more than
 // `truncation_m` behind the surface, and those not `valid`, are ignored (`fused` false); in
-// front they are clamped. Written without branches so that T may be a GCC vector of voxels
-// (Mask then holds all-ones lanes for true); T = float, Mask = bool is the scalar rule.
-// Arguments by reference: a vector by value changes the calling convention between the AVX2
-// clone and the baseline.
+// front they are clamped. A voxel's first fusion starts from weight 0 and kUnobservedSdf, which
+// the product sdf_m * weight turns into 0 (tsdf_volume.h). Written without branches so that T may
+// be a GCC vector of voxels (Mask then holds all-ones lanes for true); T = float, Mask = bool is
+// the scalar rule. Arguments by reference: a vector by value changes the calling convention between
+// the AVX2 clone and the baseline.
 template <class T, class Mask>
 GLINT_HOST_DEVICE inline void fuse_voxel(const T& measured_sdf_m, const T& truncation_m,
                                          float max_weight, const Mask& valid, T& sdf_m, T& weight,

@@ -86,8 +86,9 @@ class TsdfSampler {
     const int block = cached_block(x >> 3, y >> 3, z >> 3);  // floor division by 8
     if (block < 0) return Sample::unallocated;
     const int index = voxel_in_block(x, y, z);
-    if (volume_.weight(block)[index] <= 0) return Sample::unobserved;
-    sdf_m = volume_.sdf_m(block)[index];
+    const float sdf = volume_.sdf_m(block)[index];
+    if (!observed(sdf)) return Sample::unobserved;
+    sdf_m = sdf;
     return Sample::observed;
   }
 

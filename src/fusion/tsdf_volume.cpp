@@ -27,7 +27,7 @@ int TsdfVolume::allocate(const Eigen::Vector3i& block) {
   const VoxelBlockHash::Insertion insertion = hash_.insert(block);
   if (insertion.inserted) {
     const int b = insertion.index;
-    std::fill_n(sdf_m(b), kVoxelsPerBlock, 0.0f);
+    std::fill_n(sdf_m(b), kVoxelsPerBlock, kUnobservedSdf);
     std::fill_n(weight(b), kVoxelsPerBlock, 0.0f);
     if (has_colour()) {
       std::fill_n(red(b), kVoxelsPerBlock, 0.0f);

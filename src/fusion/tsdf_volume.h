@@ -2,14 +2,16 @@
 // TsdfVolume: the voxel-hashed truncated signed distance field with colour. Voxel data are flat
 // structure-of-arrays pools indexed by block * kVoxelsPerBlock + voxel, voxel = (z*8 + y)*8 + x;
 // the pools are allocated once (capacity from VolumeParams) and their pages are committed only
-// as blocks are used. A voxel with weight 0 has never been observed.
+// as blocks are used.
 //
 // Voxel values: sdf_m, signed distance along the viewing ray in metres (positive in front of the
-// surface), clamped to the truncation band; weight, number of fused observations (saturating);
+// surface), clamped to the truncation band, or kUnobservedSdf in a voxel never observed; weight,
+// number of fused observations (saturating; 0 exactly where sdf_m is kUnobservedSdf);
 // red, green, blue, weighted mean linear colour (only in volumes that keep colour).
 #include <Eigen/Core>
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -26,6 +28,14 @@ GLINT_HOST_DEVICE inline int voxel_in_block(int x, int y, int z) {
          (x & (kBlockSide - 1));
 }
 
+// The distance a new block's voxels hold until their first observation. Readers test it instead
+// of the weight, so a sample reads one pool instead of two (the observation grid's surface
+// refreshes stalled on the weights' cache misses as much as on the distances'). It is finite, so
+// the first fusion's running average, (sdf * 0 + observation) / 1, takes the observation alone:
+// no kernel treats it specially.
+inline constexpr float kUnobservedSdf = std::numeric_limits<float>::max();
+GLINT_HOST_DEVICE inline bool observed(float sdf_m) { return sdf_m != kUnobservedSdf; }
+
 class TsdfVolume {
  public:
   explicit TsdfVolume(const VolumeParams& params = {});
@@ -40,8 +50,8 @@ class TsdfVolume {
     return block.cast<double>() * params_.block_size_m();
   }
 
-  // Inserts the block (zeroed) if absent; thread-safe against concurrent calls. Returns its
-  // pool index or VoxelBlockHash::kPoolFull.
+  // Inserts the block (unobserved: kUnobservedSdf, weight and colour 0) if absent; thread-safe
+  // against concurrent calls. Returns its pool index or VoxelBlockHash::kPoolFull.
   int allocate(const Eigen::Vector3i& block);
 
   // Whether the volume keeps colour (VolumeParams::colour); red(), green(), blue() need it.
@@ -58,13 +68,11 @@ class TsdfVolume {
   const float* green(int block) const { return green_.get() + voxel_offset(block); }
   const float* blue(int block) const { return blue_.get() + voxel_offset(block); }
 
-  // Asks for a block's distances and weights (4 KB) ahead of reading them.
+  // Asks for a block's distances (2 KB) ahead of reading them (TsdfSampler reads no weights).
   void prefetch_block(int block) const {
     constexpr int kFloatsPerLine = 64 / sizeof(float);
-    for (int offset = 0; offset < kVoxelsPerBlock; offset += kFloatsPerLine) {
+    for (int offset = 0; offset < kVoxelsPerBlock; offset += kFloatsPerLine)
       __builtin_prefetch(sdf_m(block) + offset);
-      __builtin_prefetch(weight(block) + offset);
-    }
   }
 
   // How many frames have been fused into a block (saturating at 255). integrate_blocks counts

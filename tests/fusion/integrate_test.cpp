@@ -49,6 +49,7 @@ TEST(Integrate, FrontoParallelPlaneGivesTheAnalyticSdf) {
       if (!in_view) continue;
       if (sdf < -0.04 - 1e-6) {
         EXPECT_EQ(volume.weight(block)[v], 0.0f) << "behind the band: never observed";
+        EXPECT_EQ(volume.sdf_m(block)[v], kUnobservedSdf);
         continue;
       }
       if (sdf < -0.04 + 1e-6) continue;

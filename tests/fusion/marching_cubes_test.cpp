@@ -86,8 +86,16 @@ TEST(MarchingCubes, UnobservedVoxelsEmitNothing) {
   TsdfVolume volume;
   EXPECT_TRUE(extract_mesh(volume).triangles.empty());
   const int block = volume.allocate({0, 0, 0});
-  volume.sdf_m(block)[0] = -0.01f;  // weight still 0
-  EXPECT_TRUE(extract_mesh(volume).vertices.empty());
+  EXPECT_TRUE(extract_mesh(volume).vertices.empty()) << "a new block is unobserved";
+  // Observed: +1 cm everywhere but -1 cm at voxel 0, whose cubes then cross the surface.
+  std::fill_n(volume.sdf_m(block), kVoxelsPerBlock, 0.01f);
+  std::fill_n(volume.weight(block), kVoxelsPerBlock, 1.0f);
+  volume.sdf_m(block)[0] = -0.01f;
+  EXPECT_FALSE(extract_mesh(volume).vertices.empty());
+  volume.sdf_m(block)[0] = kUnobservedSdf;
+  volume.weight(block)[0] = 0;
+  EXPECT_TRUE(extract_mesh(volume).vertices.empty())
+      << "the only crossing cubes had voxel 0 as a corner";
 }
 
 TEST(MarchingCubes, PlyOutputHasHeaderCountsAndColours) {

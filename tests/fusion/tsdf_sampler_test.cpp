@@ -64,7 +64,9 @@ TEST(TsdfSampler, AnUnobservedFaceNeighbourFailsTheGradientOnly) {
   // Voxel (3, 1, 1): in the +x face stencil, not in the cell's own eight.
   const int block = volume.hash().find({0, 0, 0});
   ASSERT_GE(block, 0);
-  volume.weight(block)[(1 * kBlockSide + 1) * kBlockSide + 3] = 0;
+  const int forgotten = (1 * kBlockSide + 1) * kBlockSide + 3;
+  volume.sdf_m(block)[forgotten] = kUnobservedSdf;
+  volume.weight(block)[forgotten] = 0;
   TsdfSampler sampler(volume);
   float value = 0;
   Eigen::Vector3f gradient;
@@ -76,9 +78,12 @@ TEST(TsdfSampler, ABlockOfTheSameParityIsLookedUpAfresh) {
   // Blocks 0 and 2 along x share a cache entry; only block 0 is allocated.
   TsdfVolume volume(centimetre_voxels());
   ASSERT_GE(volume.allocate({0, 0, 0}), 0);
-  std::fill_n(volume.weight(volume.hash().find({0, 0, 0})), kVoxelsPerBlock, 1.0f);
+  const int block = volume.hash().find({0, 0, 0});
   TsdfSampler sampler(volume);
   float sdf = 0;
+  EXPECT_EQ(sampler.voxel(3, 3, 3, sdf), TsdfSampler::Sample::unobserved) << "not yet fused";
+  std::fill_n(volume.sdf_m(block), kVoxelsPerBlock, 0.01f);
+  std::fill_n(volume.weight(block), kVoxelsPerBlock, 1.0f);
   EXPECT_EQ(sampler.voxel(3, 3, 3, sdf), TsdfSampler::Sample::observed);
   EXPECT_EQ(sampler.voxel(19, 3, 3, sdf), TsdfSampler::Sample::unallocated);
   EXPECT_EQ(sampler.voxel(3, 3, 3, sdf), TsdfSampler::Sample::observed);
