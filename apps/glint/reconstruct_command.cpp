@@ -288,7 +288,7 @@ void register_reconstruct_command(CLI::App& app) {
       ->capture_default_str();
   command
       ->add_option("--obs-voxels", params.observations.voxel_capacity,
-                   "Observation voxel pool (about 1.1 KB each, committed as used); default 2^20 "
+                   "Observation voxel pool (about 0.8 KB each, committed as used); default 2^20 "
                    "at 2 cm, 2 x (0.02 / obs-voxel)^2 times that below")
       ->check(CLI::PositiveNumber);
   command

@@ -25,12 +25,12 @@ using namespace glint::reflectance;
 std::vector<Observation> random_observations(int count, std::uint64_t seed) {
   std::mt19937_64 random(seed);
   std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
-  std::vector<Observation> observations(count);
+  std::vector<Observation> observations;
   for (int k = 0; k < count; ++k) {
-    Eigen::Vector3f d(uniform(random) * 2 - 1, uniform(random) * 2 - 1, uniform(random) + 0.05f);
-    observations[k].direction = d.normalized();
-    observations[k].colour = Eigen::Vector3f(uniform(random), uniform(random), uniform(random));
-    observations[k].frame = std::uint32_t(k);
+    const Eigen::Vector3f d(uniform(random) * 2 - 1, uniform(random) * 2 - 1,
+                            uniform(random) + 0.05f);
+    const Eigen::Vector3f colour(uniform(random), uniform(random), uniform(random));
+    observations.emplace_back(colour, d.normalized(), std::uint32_t(k));
   }
   return observations;
 }
@@ -84,14 +84,16 @@ void InsertIntoFullVoxel(benchmark::State& state) {
   if (along_path)
     for (std::size_t k = 0; k < incoming.size(); ++k) {
       const float t = 0.01f * float(k);  // about 0.6 degrees per frame
-      incoming[k].direction =
-          Eigen::Vector3f(0.6f * std::cos(t), 0.6f * std::sin(1.3f * t), 0.8f).normalized();
+      incoming[k] = Observation(
+          incoming[k].colour(),
+          Eigen::Vector3f(0.6f * std::cos(t), 0.6f * std::sin(1.3f * t), 0.8f).normalized(),
+          incoming[k].frame());
     }
   std::size_t next = 0;
   for (auto _ : state) {
     const int v = int(next % kVoxels);
-    Observation added = incoming[(next / kVoxels) % incoming.size()];
-    added.frame = std::uint32_t(100 + next);
+    const Observation& next_seen = incoming[(next / kVoxels) % incoming.size()];
+    const Observation added(next_seen.colour(), next_seen.direction(), std::uint32_t(100 + next));
     ++next;
     benchmark::DoNotOptimize(insert_observation(slots[v].data(), nearest[v].data(), 30, 30, added));
   }

@@ -94,7 +94,7 @@ std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int 
   std::array<float, kMaxObservationsPerVoxel> x, y, z;
   int used = 0;
   for (int k = 0; k < std::min(count, kMaxObservationsPerVoxel); ++k) {
-    const Eigen::Vector3f& direction = observations[k].direction;
+    const Eigen::Vector3f direction = observations[k].direction();
     if (!(normal.dot(direction) > 0.0f)) continue;
     x[used] = direction.x();
     y[used] = direction.y();
@@ -129,8 +129,9 @@ std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int 
   std::array<Channels, std::max(kMaxObservationsPerVoxel, kNetworkSize)> values;
   for (int j = 0; j < used; ++j) {
     values[j] = Channels{};
+    const Eigen::Vector3f colour = seen[j]->colour();
     for (int c = 0; c < 3; ++c)
-      values[j][c] = float(M_PI) * (seen[j]->colour[c] - ks[c] * specular[j][c]) / diffuse[c];
+      values[j][c] = float(M_PI) * (colour[c] - ks[c] * specular[j][c]) / diffuse[c];
   }
   if (average == AlbedoAverage::median) {
     refined.kd = channel_medians(values.data(), used);

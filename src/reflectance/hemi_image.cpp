@@ -47,7 +47,7 @@ void make_hemi_image(const Observation* observations, int count, const Eigen::Ve
   const float half_extent = 0.5f * float(size - 1);
   int kept = 0;
   for (int k = 0; k < count && kept < kMaxObservations; ++k) {
-    const Eigen::Vector3f local = to_local * observations[k].direction;
+    const Eigen::Vector3f local = to_local * observations[k].direction();
     if (local.z() <= 0.0f) continue;
     position[kept] = (project_to_disk(local, params.projection).array() + 1.0f) * half_extent;
     source[kept++] = k;
@@ -82,8 +82,9 @@ void make_hemi_image(const Observation* observations, int count, const Eigen::Ve
     }
     for (int x = 0; x < size; ++x) {
       const int nearest_index = index[x / kHemiLanes][x % kHemiLanes];
-      const Eigen::Vector3f colour =
-          nearest_index < 0 ? Eigen::Vector3f::Zero() : observations[source[nearest_index]].colour;
+      const Eigen::Vector3f colour = nearest_index < 0
+                                         ? Eigen::Vector3f::Zero()
+                                         : observations[source[nearest_index]].colour();
       for (int c = 0; c < 3; ++c) out[c * pixels + y * size + x] = colour[c];
     }
   }

@@ -5,15 +5,58 @@
 // similar (closest in direction) is dropped, so the kept set tends towards uniform coverage
 // of the hemisphere around the normal.
 #include <Eigen/Core>
+#include <array>
+#include <bit>
 #include <cstdint>
 
 namespace glint::reflectance {
 
-struct Observation {
-  Eigen::Vector3f colour = Eigen::Vector3f::Zero();      // linear RGB
-  Eigen::Vector3f direction = Eigen::Vector3f::UnitZ();  // unit, surface towards camera, world
-  std::uint32_t frame = 0;                               // frame it was observed in
+// One stored observation in 16 bytes instead of 28 as floats: the pools hold m = 30 per voxel,
+// and at 1 cm their pages' first touch and their cache misses are a large part of the
+// observation stage (cubes, 1 cm: 195 MB less peak memory). The colour is kept as IEEE binary16,
+// relative error at most 2^-11 (an 8-bit input's step is 2^-8 or more); the direction as three
+// signed 16-bit fractions, error at most 1.6e-5 per component.
+class Observation {
+ public:
+  Observation() = default;  // black, along +z, frame 0
+  // `colour`: linear RGB radiance; negative and NaN channels store 0, those above 65504 (the
+  // largest half) store 65504. `direction`: a unit vector.
+  Observation(const Eigen::Vector3f& colour, const Eigen::Vector3f& direction, std::uint32_t frame);
+
+  Eigen::Vector3f colour() const;
+  Eigen::Vector3f direction() const {  // unit to within the storage error
+    return Eigen::Vector3f(direction_[0], direction_[1], direction_[2]) * (1.0f / kUnit);
+  }
+  std::uint32_t frame() const { return frame_; }  // the frame it was observed in
+  // direction() . other.direction(), from the stored integers (the same on every call).
+  float similarity(const Observation& other) const {
+    const std::int32_t dot = std::int32_t(direction_[0]) * other.direction_[0] +
+                             std::int32_t(direction_[1]) * other.direction_[1] +
+                             std::int32_t(direction_[2]) * other.direction_[2];
+    return float(dot) * (1.0f / (float(kUnit) * float(kUnit)));
+  }
+
+ private:
+  static constexpr std::int16_t kUnit = 32767;
+  std::array<std::uint16_t, 3> colour_{};  // binary16 bits
+  std::array<std::int16_t, 3> direction_{0, 0, kUnit};
+  std::uint32_t frame_ = 0;
 };
+static_assert(sizeof(Observation) == 16);
+
+// IEEE binary16 bits of a non-negative value (round to nearest; negative and NaN give 0, values
+// above 65504 give 65504) and back. Exposed for the tests.
+std::uint16_t half_from_float(float value);
+inline float float_from_half(std::uint16_t half) {
+  // The half's exponent and mantissa in a float's low exponent bits, rescaled by 2^(127 - 15):
+  // exact for normal, subnormal and zero halves alike, and one multiply (the albedo stage decodes
+  // 90 colours per voxel).
+  return std::bit_cast<float>(std::uint32_t(half & 0x7fff) << 13) * 0x1p112f;
+}
+
+inline Eigen::Vector3f Observation::colour() const {
+  return {float_from_half(colour_[0]), float_from_half(colour_[1]), float_from_half(colour_[2])};
+}
 
 // For each stored observation, its most similar other stored observation: the slot and their
 // direction dot product (-2 while it is alone). Kept up to date by insert_observation, so the

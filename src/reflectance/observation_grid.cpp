@@ -382,13 +382,11 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
       for (int i = 0; i < pending; ++i) {
         const Seen& voxel = seen[i];
         const int v = voxel.voxel;
-        Observation observation;
-        observation.colour =
+        const Observation observation(
             Eigen::Vector3f(colour.plane(0)[voxel.pixel], colour.plane(1)[voxel.pixel],
                             colour.plane(2)[voxel.pixel]) *
-            inverse_exposure;
-        observation.direction = voxel.direction;
-        observation.frame = std::uint32_t(frame);
+                inverse_exposure,
+            voxel.direction, std::uint32_t(frame));
         if (observation_set_[v] == 0)
           observation_set_[v] = 1 + observation_sets_used_.fetch_add(1, std::memory_order_relaxed);
         const std::size_t first = first_slot(v);

@@ -47,7 +47,7 @@ struct ObservationGridParams {
   // Pool size; exhaustion is a glint::Error. 0: 2^20 voxels at 2 cm and above, and
   // 2 (0.02 / voxel_size_m)^2 times that below (a surface holds (0.02 / v)^2 times as many
   // voxels, and finer grids leave more of each block empty). About 60 bytes per voxel and
-  // 1.1 KB of observation slots per voxel that has been observed, committed as they are used.
+  // 720 bytes of observation slots per voxel that has been observed, committed as they are used.
   std::size_t voxel_capacity = 0;
   int allocation_stride_px = 2;       // every n-th pixel of every n-th row allocates
   double depth_tolerance_m = 0.01;    // |measured - voxel depth| allowed, plus ...

@@ -62,19 +62,20 @@ void LobeProblem::add_voxel(const FitVoxel& voxel, const std::vector<render::Poi
   Eigen::Vector3f mean = Eigen::Vector3f::Zero();
   for (int k = 0; k < std::min(voxel.count, kMaxObservationsPerVoxel); ++k) {
     const Observation& o = voxel.observations[k];
-    const float cos_o = voxel.normal.dot(o.direction);
-    if (!(cos_o > 0.0f) || !(o.colour.maxCoeff() < params.saturated_radiance)) continue;
+    const Eigen::Vector3f direction = o.direction(), colour = o.colour();
+    const float cos_o = voxel.normal.dot(direction);
+    if (!(cos_o > 0.0f) || !(colour.maxCoeff() < params.saturated_radiance)) continue;
     const int index = observations();
     if (cos_o > render::kGrazingCosine)  // a grazing view has no lobe term (render/ward.h)
       for (const Incidence& in : lit_) {
-        const float tan2 = render::ward_half_angle_tan2(voxel.normal, in.direction, o.direction);
+        const float tan2 = render::ward_half_angle_tan2(voxel.normal, in.direction, direction);
         if (tan2 > negligible_tan2) continue;  // no lobe in the searched range reaches it
         tan2_.push_back(tan2);
         weight_.push_back(in.irradiance / (4.0f * float(M_PI) * std::sqrt(in.cosine * cos_o)));
         term_observation_.push_back(index);
       }
-    centred_colour_.push_back(o.colour);
-    mean += o.colour;
+    centred_colour_.push_back(colour);
+    mean += colour;
   }
   const int added = observations() - first;
   if (added < 2) {  // one observation has no variation to explain

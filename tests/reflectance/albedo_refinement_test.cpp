@@ -29,22 +29,19 @@ TEST(AlbedoRefinement, RecoversTheDiffuseAlbedoOfARenderedVoxel) {
   const Eigen::Vector3f position(0.1f, 0.0f, 0.2f), normal = Eigen::Vector3f::UnitY();
   std::vector<Observation> obs;
   for (int k = 0; k < 12; ++k) {  // views all round, some close to the mirror direction
-    Observation o;
-    o.direction =
+    const Eigen::Vector3f direction =
         Eigen::Vector3f(std::cos(0.5f * k), 0.4f + 0.1f * k, std::sin(0.5f * k)).normalized();
-    o.colour = observed(m, position, normal, o.direction, lights);
-    obs.push_back(o);
+    obs.emplace_back(observed(m, position, normal, direction, lights), direction, k);
   }
   // And the mirror direction of the first light, where the specular lobe dominates.
   const Eigen::Vector3f wi = (lights[0].position.cast<float>() - position).normalized();
-  Observation mirror;
-  mirror.direction = 2 * normal.dot(wi) * normal - wi;
-  mirror.colour = observed(m, position, normal, mirror.direction, lights);
-  obs.push_back(mirror);
+  const Eigen::Vector3f mirror = 2 * normal.dot(wi) * normal - wi;
+  obs.emplace_back(observed(m, position, normal, mirror, lights), mirror, 12);
   const auto refined =
       refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks, m.alpha);
   ASSERT_TRUE(refined.has_value());
-  EXPECT_TRUE(refined->kd.isApprox(m.kd, 1e-4f)) << refined->kd.transpose();
+  // Exact up to the observations' storage: binary16 colours, 2^-11 relative.
+  EXPECT_TRUE(refined->kd.isApprox(m.kd, 1e-3f)) << refined->kd.transpose();
 
   // Ignoring the specular part over-estimates kd: the refinement does use ks and alpha.
   const auto diffuse_only = refine_albedo(obs.data(), int(obs.size()), position, normal, lights,
@@ -63,19 +60,19 @@ TEST(AlbedoRefinement, MedianIgnoresAMispredictedHighlight) {
   const Eigen::Vector3f position = Eigen::Vector3f::Zero(), normal = Eigen::Vector3f::UnitY();
   std::vector<Observation> obs;
   for (int k = 0; k < 9; ++k) {
-    Observation o;
-    o.direction = Eigen::Vector3f(std::cos(0.7f * k), 1.0f, std::sin(0.7f * k)).normalized();
-    o.colour = observed(m, position, normal, o.direction, lights);
-    obs.push_back(o);
+    const Eigen::Vector3f direction =
+        Eigen::Vector3f(std::cos(0.7f * k), 1.0f, std::sin(0.7f * k)).normalized();
+    // Observation 4: a highlight the segment's ks and alpha do not predict.
+    obs.emplace_back(observed(m, position, normal, direction, lights) * (k == 4 ? 3.0f : 1.0f),
+                     direction, k);
   }
-  obs[4].colour *= 3.0f;  // a highlight the segment's ks and alpha do not predict
   const auto median = refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks,
                                     m.alpha, AlbedoAverage::median);
   const auto mean = refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks,
                                   m.alpha, AlbedoAverage::mean);
   ASSERT_TRUE(median && mean);
   // Each clean observation alone gives kd exactly; the median is one of them.
-  EXPECT_TRUE(median->kd.isApprox(m.kd, 1e-4f)) << median->kd.transpose();
+  EXPECT_TRUE(median->kd.isApprox(m.kd, 1e-3f)) << median->kd.transpose();  // binary16 colours
   EXPECT_GT(mean->kd.x(), m.kd.x() + 0.05f);
   EXPECT_EQ(parse_albedo_average("median"), AlbedoAverage::median);
   EXPECT_THROW(parse_albedo_average("mode"), Error);
@@ -91,16 +88,17 @@ TEST(AlbedoRefinement, MedianIsThePerChannelMedianForEveryCount) {
   std::mt19937 random(7);
   std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
   for (int n = 1; n <= 40; ++n) {  // across the 32 of the sorting network
-    std::vector<Observation> obs(n);
+    std::vector<Observation> obs;
     std::array<std::vector<float>, 3> albedos;
-    for (Observation& o : obs) {
-      o.direction = Eigen::Vector3f(uniform(random) - 0.5f, 1, uniform(random) - 0.5f).normalized();
-      for (int c = 0; c < 3; ++c) {
-        // Few distinct values, so that ties occur.
-        const float albedo = std::round(uniform(random) * 8) / 8;
-        o.colour[c] = albedo / float(M_PI);
-        albedos[c].push_back(albedo);
-      }
+    for (int k = 0; k < n; ++k) {
+      const Eigen::Vector3f direction =
+          Eigen::Vector3f(uniform(random) - 0.5f, 1, uniform(random) - 0.5f).normalized();
+      Eigen::Vector3f colour;
+      for (int c = 0; c < 3; ++c)  // few distinct values, so that ties occur
+        colour[c] = std::round(uniform(random) * 8) / 8 / float(M_PI);
+      obs.emplace_back(colour, direction, k);
+      // The albedo of the colour as stored (binary16).
+      for (int c = 0; c < 3; ++c) albedos[c].push_back(obs.back().colour()[c] * float(M_PI));
     }
     const auto refined = refine_albedo(obs.data(), n, Eigen::Vector3f::Zero(), normal, lights,
                                        {0, 0, 0}, 0.1f, AlbedoAverage::median);
@@ -115,9 +113,7 @@ TEST(AlbedoRefinement, MedianIsThePerChannelMedianForEveryCount) {
 }
 
 TEST(AlbedoRefinement, LightCosineIsTheEffectiveIncidenceOfTheLights) {
-  Observation o;
-  o.direction = Eigen::Vector3f::UnitY();
-  o.colour = {0.5f, 0.5f, 0.5f};
+  const Observation o(Eigen::Vector3f::Constant(0.5f), Eigen::Vector3f::UnitY(), 0);
   const Eigen::Vector3f normal = Eigen::Vector3f::UnitY();
   const auto light_cosine = [&](const std::vector<render::PointLight>& lights) {
     return refine_albedo(&o, 1, Eigen::Vector3f::Zero(), normal, lights, {0, 0, 0}, 0.1f)
@@ -145,15 +141,13 @@ TEST(AlbedoRefinement, LightCosineIsTheEffectiveIncidenceOfTheLights) {
 TEST(AlbedoRefinement, UnlitOrUnseenVoxelsHaveNoEstimate) {
   std::vector<render::PointLight> below(1);
   below[0].position = {0, -1, 0};
-  Observation o;
-  o.direction = Eigen::Vector3f::UnitY();
-  o.colour = {0.5f, 0.5f, 0.5f};
+  Observation o(Eigen::Vector3f::Constant(0.5f), Eigen::Vector3f::UnitY(), 0);
   const Eigen::Vector3f normal = Eigen::Vector3f::UnitY();
   EXPECT_FALSE(refine_albedo(&o, 1, Eigen::Vector3f::Zero(), normal, below, {0, 0, 0}, 0.1f));
   std::vector<render::PointLight> above(1);
   above[0].position = {0, 1, 0};
   EXPECT_FALSE(refine_albedo(&o, 0, Eigen::Vector3f::Zero(), normal, above, {0, 0, 0}, 0.1f));
-  o.direction = -Eigen::Vector3f::UnitY();  // seen from below the surface
+  o = Observation(o.colour(), -Eigen::Vector3f::UnitY(), 0);  // seen from below the surface
   EXPECT_FALSE(refine_albedo(&o, 1, Eigen::Vector3f::Zero(), normal, above, {0, 0, 0}, 0.1f));
 }
 

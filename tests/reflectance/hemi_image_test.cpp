@@ -34,13 +34,11 @@ TEST(HemiImage, ParabolicMapKnownValues) {
 TEST(HemiImage, NearestNeighbourFillSplitsTheDisk) {
   // Normal +z; a red observation towards +x and a blue one towards -x: the left half of the
   // image is blue, the right half red; the centre column is equidistant.
-  std::vector<Observation> obs(3);
-  obs[0].direction = Eigen::Vector3f(1, 0, 1).normalized();
-  obs[0].colour = {1, 0, 0};
-  obs[1].direction = Eigen::Vector3f(-1, 0, 1).normalized();
-  obs[1].colour = {0, 0, 1};
-  obs[2].direction = {0, 0, -1};  // below the surface: ignored
-  obs[2].colour = {0, 1, 0};
+  const std::vector<Observation> obs = {
+      {{1, 0, 0}, Eigen::Vector3f(1, 0, 1).normalized(), 0},
+      {{0, 0, 1}, Eigen::Vector3f(-1, 0, 1).normalized(), 1},
+      {{0, 1, 0}, {0, 0, -1}, 2},  // below the surface: ignored
+  };
   HemiImageParams params;
   std::vector<float> image(3 * 15 * 15, -1.0f);
   make_hemi_image(obs.data(), 3, Eigen::Vector3f::UnitZ(), params, image.data());

@@ -54,9 +54,9 @@ TEST(ObservationGrid, WallVoxelsLieOnTheWallAndFaceTheCamera) {
     EXPECT_NEAR(grid.normal(v).z(), -1.0f, 1e-3f);
     ASSERT_EQ(grid.observation_count(v), 1);
     const Observation& o = grid.observations(v)[0];
-    EXPECT_NEAR(o.colour.x(), 0.5f, 1e-6f) << "radiance = colour / exposure";
-    EXPECT_NEAR(o.direction.norm(), 1.0f, 1e-5f);
-    EXPECT_LT(o.direction.z(), 0.0f) << "towards the camera";
+    EXPECT_NEAR(o.colour().x(), 0.5f, 1e-6f) << "radiance = colour / exposure";
+    EXPECT_NEAR(o.direction().norm(), 1.0f, 5e-5f) << "unit, to 16-bit fractions";
+    EXPECT_LT(o.direction().z(), 0.0f) << "towards the camera";
     // The voxel contains its surface point.
     EXPECT_EQ(grid.find(grid.position(v)), v);
   }

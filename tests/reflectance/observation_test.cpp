@@ -11,11 +11,9 @@ namespace glint::reflectance {
 namespace {
 
 Observation seen_from(float theta, float phi, std::uint32_t frame) {
-  Observation o;
-  o.direction = {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
-  o.colour = Eigen::Vector3f::Constant(float(frame));
-  o.frame = frame;
-  return o;
+  return Observation(
+      Eigen::Vector3f::Constant(float(frame)),
+      {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)}, frame);
 }
 
 // A voxel's slots with their nearest-neighbour bookkeeping.
@@ -41,11 +39,49 @@ int reference_insert(std::vector<Observation>& slots, int count, int capacity,
   float best = -2.0f;
   for (int a = 0; a <= capacity; ++a)
     for (int b = a + 1; b <= capacity; ++b)
-      if (at(a).direction.dot(at(b).direction) > best)
-        best = at(a).direction.dot(at(b).direction), best_a = a, best_b = b;
-  const int dropped = at(best_a).frame <= at(best_b).frame ? best_a : best_b;
+      if (at(a).similarity(at(b)) > best) best = at(a).similarity(at(b)), best_a = a, best_b = b;
+  const int dropped = at(best_a).frame() <= at(best_b).frame() ? best_a : best_b;
   if (dropped != capacity) slots[dropped] = added;
   return capacity;
+}
+
+TEST(Observations, HalfColoursRoundTripWithinHalfAStep) {
+  // Exact: zero, powers of two, integers up to 2048, the largest half, the smallest subnormal.
+  for (float exact : {0.0f, 1.0f, 0.5f, 0.25f, 3.0f, 2048.0f, 65504.0f, 5.9604645e-08f})
+    EXPECT_EQ(float_from_half(half_from_float(exact)), exact) << exact;
+  EXPECT_EQ(half_from_float(1.0f), 0x3c00);  // IEEE binary16 bits
+  EXPECT_EQ(half_from_float(65504.0f), 0x7bff);
+  // Everything else within 2^-11 relative (normal range) or 2^-25 absolute (subnormal range).
+  std::mt19937 random(3);
+  std::uniform_real_distribution<float> exponent(-30.0f, 15.9f);
+  for (int i = 0; i < 100000; ++i) {
+    const float value = std::exp2(exponent(random));
+    const float back = float_from_half(half_from_float(value));
+    EXPECT_LE(std::fabs(back - value), std::max(value * 0x1p-11f, 0x1p-25f)) << value;
+  }
+  // Out of range: negative and NaN store 0, beyond the largest half stores it.
+  EXPECT_EQ(half_from_float(-0.5f), 0);
+  EXPECT_EQ(half_from_float(std::nanf("")), 0);
+  EXPECT_EQ(float_from_half(half_from_float(1e6f)), 65504.0f);
+}
+
+TEST(Observations, StoreColourDirectionAndFrameIn16Bytes) {
+  const Eigen::Vector3f colour(0.8f, 0.0123f, 1.7f);
+  const Eigen::Vector3f direction = Eigen::Vector3f(0.3f, -0.5f, 0.8f).normalized();
+  const Observation o(colour, direction, 123456);
+  EXPECT_EQ(sizeof(Observation), 16u);
+  EXPECT_EQ(o.frame(), 123456u);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(o.colour()[c], colour[c], colour[c] * 0x1p-11f);
+    EXPECT_NEAR(o.direction()[c], direction[c], 1.6e-5f);
+  }
+  EXPECT_NEAR(o.similarity(o), 1.0f, 5e-5f);
+  const Observation opposite(colour, -direction, 0);
+  EXPECT_NEAR(o.similarity(opposite), -1.0f, 5e-5f);
+  EXPECT_EQ(o.similarity(opposite), opposite.similarity(o));
+  const Observation none;
+  EXPECT_EQ(none.colour(), Eigen::Vector3f::Zero());
+  EXPECT_EQ(none.direction(), Eigen::Vector3f::UnitZ());
 }
 
 TEST(Observations, FillUpToCapacityThenStayFull) {
@@ -70,7 +106,7 @@ TEST(Observations, KeepsTheSameObservationsAsTheBruteForceDefinition) {
       reference_count = reference_insert(reference, reference_count, capacity, o);
       ASSERT_EQ(voxel.count, reference_count);
       for (int k = 0; k < capacity && k < voxel.count; ++k)
-        ASSERT_EQ(voxel.slots[k].frame, reference[k].frame)
+        ASSERT_EQ(voxel.slots[k].frame(), reference[k].frame())
             << "capacity " << capacity << " frame " << f;
     }
   }
@@ -85,7 +121,7 @@ TEST(Observations, OverflowDropsTheOlderOfTheMostSimilarPair) {
   voxel.insert(seen_from(1.15f, 0.05f, 3));
   ASSERT_EQ(voxel.count, 3);
   std::vector<std::uint32_t> frames;
-  for (const Observation& o : voxel.slots) frames.push_back(o.frame);
+  for (const Observation& o : voxel.slots) frames.push_back(o.frame());
   std::sort(frames.begin(), frames.end());
   EXPECT_EQ(frames, (std::vector<std::uint32_t>{0, 2, 3}));
 }
@@ -98,7 +134,7 @@ TEST(Observations, RepeatedViewsKeepTheHemisphereCovered) {
   for (int i = 0; i < 5; ++i) voxel.insert(seen_from(1.0f, 1.25f * i, frame++));
   for (int i = 0; i < 300; ++i) voxel.insert(seen_from(0.05f + 0.0001f * i, 0.0f, frame++));
   int distinct = 0;
-  for (int k = 0; k < voxel.count; ++k) distinct += voxel.slots[k].frame < 5;
+  for (int k = 0; k < voxel.count; ++k) distinct += voxel.slots[k].frame() < 5;
   EXPECT_EQ(distinct, 5);
 }
 

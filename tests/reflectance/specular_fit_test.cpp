@@ -49,10 +49,8 @@ Segment render_segment(Eigen::Vector3f ks, float alpha,
     auto& obs = segment.observations[v];
     auto add = [&](const Eigen::Vector3f& direction) {
       if (normal.dot(direction) <= 0.05f) return;
-      Observation o;
-      o.direction = direction;
-      o.colour = observed(m, position, normal, direction, lights).cwiseMin(clip);
-      obs.push_back(o);
+      obs.emplace_back(observed(m, position, normal, direction, lights).cwiseMin(clip), direction,
+                       0);
     };
     for (int k = 0; k < 16; ++k)
       add(Eigen::Vector3f(uniform(random), 0.2f + std::abs(uniform(random)), uniform(random))
@@ -114,7 +112,8 @@ TEST(SpecularFit, AMatteOrNoisySegmentHasNoFit) {
   std::normal_distribution<float> noise(0.0f, 0.02f);
   for (auto& obs : matte.observations)
     for (Observation& o : obs)
-      o.colour += Eigen::Vector3f(noise(random), noise(random), noise(random));
+      o = Observation(o.colour() + Eigen::Vector3f(noise(random), noise(random), noise(random)),
+                      o.direction(), o.frame());
   EXPECT_FALSE(fit_specular(matte.voxels, lights).has_value());
   // No light, no voxels, single observations: nothing to fit either.
   EXPECT_FALSE(fit_specular(matte.voxels, {}).has_value());
