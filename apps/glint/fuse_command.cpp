@@ -156,7 +156,10 @@ void add_volume_options(CLI::App* command, fusion::VolumeParams& volume) {
   command->add_option("--depth-max", volume.depth_max_m, "Ignore depth beyond this, metres")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  command->add_option("--blocks", volume.block_capacity, "Block pool capacity (10 KiB per block)")
+  command
+      ->add_option("--blocks", volume.block_capacity,
+                   "Block pool capacity (4 KiB per block, 10 KiB where the volume keeps colour; "
+                   "committed as used)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   command
