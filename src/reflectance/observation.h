@@ -11,6 +11,16 @@
 
 namespace glint::reflectance {
 
+// IEEE binary16 bits of a non-negative value (round to nearest; negative and NaN give 0, values
+// above 65504 give 65504) and back. Exposed for the tests.
+std::uint16_t half_from_float(float value);
+inline float float_from_half(std::uint16_t half) {
+  // The half's exponent and mantissa in a float's low exponent bits, rescaled by 2^(127 - 15):
+  // exact for normal, subnormal and zero halves alike, and one multiply (the albedo stage decodes
+  // 90 colours per voxel).
+  return std::bit_cast<float>(std::uint32_t(half & 0x7fff) << 13) * 0x1p112f;
+}
+
 // One stored observation in 16 bytes instead of 28 as floats: the pools hold m = 30 per voxel,
 // and at 1 cm their pages' first touch and their cache misses are a large part of the
 // observation stage (cubes, 1 cm: 195 MB less peak memory). The colour is kept as IEEE binary16,
@@ -23,7 +33,9 @@ class Observation {
   // largest half) store 65504. `direction`: a unit vector.
   Observation(const Eigen::Vector3f& colour, const Eigen::Vector3f& direction, std::uint32_t frame);
 
-  Eigen::Vector3f colour() const;
+  Eigen::Vector3f colour() const {
+    return {float_from_half(colour_[0]), float_from_half(colour_[1]), float_from_half(colour_[2])};
+  }
   Eigen::Vector3f direction() const {  // unit to within the storage error
     return Eigen::Vector3f(direction_[0], direction_[1], direction_[2]) * (1.0f / kUnit);
   }
@@ -43,20 +55,6 @@ class Observation {
   std::uint32_t frame_ = 0;
 };
 static_assert(sizeof(Observation) == 16);
-
-// IEEE binary16 bits of a non-negative value (round to nearest; negative and NaN give 0, values
-// above 65504 give 65504) and back. Exposed for the tests.
-std::uint16_t half_from_float(float value);
-inline float float_from_half(std::uint16_t half) {
-  // The half's exponent and mantissa in a float's low exponent bits, rescaled by 2^(127 - 15):
-  // exact for normal, subnormal and zero halves alike, and one multiply (the albedo stage decodes
-  // 90 colours per voxel).
-  return std::bit_cast<float>(std::uint32_t(half & 0x7fff) << 13) * 0x1p112f;
-}
-
-inline Eigen::Vector3f Observation::colour() const {
-  return {float_from_half(colour_[0]), float_from_half(colour_[1]), float_from_half(colour_[2])};
-}
 
 // For each stored observation, its most similar other stored observation: the slot and their
 // direction dot product (-2 while it is alone). Kept up to date by insert_observation, so the
