@@ -62,7 +62,7 @@ reflectance::MaterialMaps render_model(const reflectance::ReflectancePipeline& p
                                           normal_radius_m);
   return reflectance::render_material_maps(view, pose, pipeline.observations(),
                                            pipeline.materials(), pipeline.lights(),
-                                           pipeline.exposure());
+                                           pipeline.exposure(), pipeline.albedo_smoothing());
 }
 
 struct ReconstructOptions {
@@ -243,6 +243,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"obs_spacing_frames", options.params.observations.spacing_max_frames},
          {"albedo_average", reflectance::albedo_average_name(options.params.albedo_average)},
          {"albedo_min_light_cosine", options.params.albedo_min_light_cosine},
+         {"albedo_smoothing", options.params.albedo_smoothing},
          {"specular", specular_name(options.params.specular)},
          {"normals", normals_name(options.params.observations)},
          {"render_normal_radius_m", options.render_normal_radius_m},
@@ -352,6 +353,14 @@ void register_reconstruct_command(CLI::App& app) {
                    "the re-renderings and the mesh use the reliable voxels around it (0 = trust "
                    "all, as the paper)")
       ->check(CLI::Range(0.0f, 1.0f))
+      ->capture_default_str();
+  command
+      ->add_option("--albedo-smoothing", params.albedo_smoothing,
+                   "Re-renderings and the mesh smooth the refined albedo between neighbouring "
+                   "observation voxels whose albedos differ by about this relative contrast or "
+                   "less (a Gaussian range weight of this standard deviation; texture edges of "
+                   "more contrast stay sharp); 0 = trilinear interpolation only, as the paper")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   command
       ->add_option_function<std::string>(

@@ -55,7 +55,7 @@ void write_material_mesh(const std::string& path,
   parallel_for(n, [&](std::size_t i) {
     reflectance::PointMaterial material;
     if (!reflectance::material_at(pipeline.observations(), pipeline.materials(), mesh.vertices[i],
-                                  material)) {
+                                  material, pipeline.albedo_smoothing())) {
       values[7][i] = float(material.segment);
       return;
     }

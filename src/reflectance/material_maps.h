@@ -2,7 +2,8 @@
 // Re-rendering of the reconstructed model from a camera (paper 1 §4.2, Figs 2-3, Table 1): the
 // surface seen by the camera (a TSDF ray cast) is looked up in the observation grid for its
 // segment and that segment's fused Ward material; the refined diffuse albedo is interpolated
-// trilinearly between the surrounding observation voxels of the same segment (§3.7); each
+// trilinearly between the surrounding observation voxels of the same segment (§3.7), and
+// optionally smoothed where neighbouring voxels agree to within the scatter of eq. (7); each
 // pixel is shaded with the Ward BRDF under the estimated near-field point lights (direct light,
 // no shadows, as the albedo refinement assumes), once with the HemiCNN's kd and once with the
 // refined kd.
@@ -40,24 +41,32 @@ Eigen::Vector3f shade_ward(const render::WardMaterial& material, const Eigen::Ve
 // albedo for p, such as the segment's refined one, keeps its own). Less a minority of outliers
 // (at most a quarter of four or more, mean albedo off their median by more than
 // kRefinedKdOutlier of it), renormalised; false when there is none.
+// With `smoothing` > 0 that estimate is then smoothed edge-preservingly: the reliable voxels of
+// the 4^3 under the wide tent, weighted by how close their albedo is to it: a Gaussian in their
+// mean absolute channel difference relative to the estimate's mean (+ 0.01), with standard
+// deviation `smoothing` (a voxel 2 * smoothing off counts e^-2 as much). 0: the paper's
+// trilinear interpolation alone.
 inline constexpr float kRefinedKdOutlier = 0.5f;
 bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& p, int segment,
-                            Eigen::Vector3f& kd, bool unreliable_corners = true);
+                            Eigen::Vector3f& kd, bool unreliable_corners = true,
+                            float smoothing = 0);
 
 // The material at surface point p: the segment of the voxel holding p (else of the nearest
 // labelled neighbour voxel), its fused Ward parameters, and the same with the refined kd (the
 // segment's fused refined kd where interpolate_refined_kd finds no reliable voxel; before the
-// segment has one, the unreliable voxels around p, else the network's kd).
-// False when p lies in no segment with a material yet.
+// segment has one, the unreliable voxels around p, else the network's kd), smoothed as
+// interpolate_refined_kd() with `albedo_smoothing`. False when p lies in no segment with a material
+// yet.
 struct PointMaterial {
   int segment = 0;
   render::WardMaterial fused, refined;
 };
 bool material_at(const ObservationGrid& grid, const SpecularEstimator& materials,
-                 const Eigen::Vector3f& p, PointMaterial& material);
+                 const Eigen::Vector3f& p, PointMaterial& material, float albedo_smoothing = 0);
 
 MaterialMaps render_material_maps(const fusion::SurfaceView& surface, const Pose& camera_to_world,
                                   const ObservationGrid& grid, const SpecularEstimator& materials,
-                                  const std::vector<render::PointLight>& lights, float exposure);
+                                  const std::vector<render::PointLight>& lights, float exposure,
+                                  float albedo_smoothing = 0);
 
 }  // namespace glint::reflectance

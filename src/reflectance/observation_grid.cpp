@@ -178,6 +178,27 @@ int ObservationGrid::find_voxel(const Eigen::Vector3i& voxel) const {
   return voxel_index(index, voxel - block * side_);
 }
 
+void ObservationGrid::find_voxels(const Eigen::Vector3i& first, int n, int* voxels) const {
+  std::fill_n(voxels, n * n * n, -1);
+  const Eigen::Vector3i last = first + Eigen::Vector3i::Constant(n - 1);
+  const Eigen::Vector3i first_block = floor_div(first, side_), last_block = floor_div(last, side_);
+  for (int bz = first_block.z(); bz <= last_block.z(); ++bz)
+    for (int by = first_block.y(); by <= last_block.y(); ++by)
+      for (int bx = first_block.x(); bx <= last_block.x(); ++bx) {
+        const int index = hash_.find({bx, by, bz});
+        if (index < 0) continue;
+        const Eigen::Vector3i origin = Eigen::Vector3i(bx, by, bz) * side_;
+        // The block's voxels within the range.
+        const Eigen::Vector3i low = origin.cwiseMax(first);
+        const Eigen::Vector3i high = (origin + Eigen::Vector3i::Constant(side_ - 1)).cwiseMin(last);
+        for (int z = low.z(); z <= high.z(); ++z)
+          for (int y = low.y(); y <= high.y(); ++y)
+            for (int x = low.x(); x <= high.x(); ++x)
+              voxels[((z - first.z()) * n + (y - first.y())) * n + (x - first.x())] =
+                  voxel_index(index, Eigen::Vector3i(x, y, z) - origin);
+      }
+}
+
 int ObservationGrid::find(const Eigen::Vector3f& p) const {
   const Eigen::Vector3f v = p / float(params_.voxel_size_m);
   return find_voxel({int(std::floor(v.x())), int(std::floor(v.y())), int(std::floor(v.z()))});

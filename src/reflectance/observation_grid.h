@@ -145,6 +145,9 @@ class ObservationGrid {
   int find(const Eigen::Vector3f& p) const;
   // Pool index of the voxel at integer grid coordinates, or -1.
   int find_voxel(const Eigen::Vector3i& voxel) const;
+  // find_voxel() of the n^3 voxels from grid coordinates `first` on (x fastest, then y, z) into
+  // voxels[0, n^3), with one hash look-up per block they touch.
+  void find_voxels(const Eigen::Vector3i& first, int n, int* voxels) const;
   // Integer grid coordinates of pool index v.
   Eigen::Vector3i voxel_coordinates(int v) const;
   // World centre of the voxel at integer grid coordinates.

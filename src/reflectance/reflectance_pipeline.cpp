@@ -3,6 +3,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "core/error.h"
@@ -45,6 +46,8 @@ ReflectancePipeline::ReflectancePipeline(const Intrinsics& intrinsics,
     throw Error("reflectance pipeline", "albedo_refresh_frames", "must be >= 1");
   if (!(params.albedo_min_light_cosine >= 0 && params.albedo_min_light_cosine <= 1))
     throw Error("reflectance pipeline", "albedo_min_light_cosine", "must be in [0, 1]");
+  if (!(params.albedo_smoothing >= 0 && std::isfinite(params.albedo_smoothing)))
+    throw Error("reflectance pipeline", "albedo_smoothing", "must be finite and >= 0");
   if (lights_.empty())
     throw Error("reflectance pipeline", "lights",
                 "needs at least one light (estimate them with `glint lights`)");

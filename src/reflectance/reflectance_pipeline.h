@@ -54,6 +54,15 @@ struct ReflectanceParams {
   // (78 degrees) is where a 2-degree normal error makes a 17 % albedo error; it was not tuned.
   // 0 trusts every voxel, as the paper does.
   float albedo_min_light_cosine = 0.2f;
+  // Re-renderings and the mesh smooth the refined albedo between neighbouring voxels that agree
+  // to about this relative contrast (interpolate_refined_kd in reflectance/material_maps.h);
+  // 0 interpolates trilinearly only, as the paper. On a uniform surface a voxel's eq. (7) albedo
+  // scatters by a few per cent (cubes, 300 frames: interquartile range 1-3.5 % of the median
+  // per cube). Chosen on cubes, which has no texture, so any value smooths (refined-kd L1
+  // 0.0169 off, 0.0157 / 0.0152 / 0.0147 / 0.0145 at 0.05 / 0.1 / 0.2 / no range weight); 0.2
+  // rather than no limit, to keep textures' contrast. Bunnies and the textured office were held
+  // out (README, "Session of 2026-11-27 (second)").
+  float albedo_smoothing = 0.2f;
   // Radiance = pixel colour / exposure; the lights are in the same radiance units
   // (reflectance/light_estimation.h).
   float exposure = 1;
@@ -86,6 +95,7 @@ class ReflectancePipeline {
   const StageTimings& timings() const { return timings_; }
   const Intrinsics& intrinsics() const { return intrinsics_; }
   float exposure() const { return params_.exposure; }
+  float albedo_smoothing() const { return params_.albedo_smoothing; }
   int frames_processed() const { return frame_; }
 
  private:

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "fusion/integrate.h"
 #include "reflectance/segment_map.h"
 
@@ -133,6 +135,46 @@ TEST(MaterialMaps, RefinedAlbedoInterpolatesWithinTheSegmentOnly) {
   ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, kd));
   EXPECT_NEAR(kd.x(), 0.5f + p.x(), 5e-3f);
   EXPECT_FALSE(interpolate_refined_kd(grid, p, 4, kd)) << "another segment's voxels are not used";
+}
+
+TEST(MaterialMaps, SmoothingAveragesTheScatterOfUniformAlbedosButKeepsATextureEdge) {
+  Wall wall;
+  ASSERT_GT(wall.voxels(), 20u);
+  // A uniform 0.4 wall whose voxels scatter by up to +-5 % (a fixed pseudo-random pattern),
+  // as eq. (7) albedos do.
+  ObservationGrid& grid = wall.with_albedo([](const Eigen::Vector3f& q) {
+    return Eigen::Vector3f::Constant(0.4f *
+                                     (1 + 0.05f * std::sin(1234.5f * q.x() + 987.6f * q.y())));
+  });
+  double trilinear_error = 0, smoothed_error = 0;
+  int points = 0;
+  for (float x = -0.1f; x <= 0.1f; x += 0.0073f)
+    for (float y = -0.08f; y <= 0.08f; y += 0.0091f) {
+      const Eigen::Vector3f p(x, y, 1.005f);
+      Eigen::Vector3f trilinear, smoothed;
+      ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, trilinear));
+      ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, smoothed, true, 0.2f));
+      trilinear_error += std::abs(trilinear.x() - 0.4f);
+      smoothed_error += std::abs(smoothed.x() - 0.4f);
+      ++points;
+    }
+  ASSERT_GT(points, 400);
+  EXPECT_GT(trilinear_error / points, 0.004);
+  // In the wall's plane the wide tent weighs 16 voxels, the trilinear one 4 (fewer near a
+  // voxel centre): independent scatter shrinks to about 0.6-0.8 of trilinear's.
+  EXPECT_LT(smoothed_error, 0.85 * trilinear_error);
+
+  // A texture edge at x = 0 between 0.3 and 0.9: a point on the dark side whose cell lies on it
+  // keeps 0.3, though the wide tent reaches the bright voxels beyond the edge ...
+  wall.with_albedo(
+      [](const Eigen::Vector3f& q) { return Eigen::Vector3f::Constant(q.x() < 0 ? 0.3f : 0.9f); });
+  const Eigen::Vector3f dark(-0.015f, -0.007f, 1.005f);
+  Eigen::Vector3f kd;
+  ASSERT_TRUE(interpolate_refined_kd(grid, dark, 3, kd, true, 0.2f));
+  EXPECT_NEAR(kd.x(), 0.3f, 1e-4f);
+  // ... which a smoothing without a range limit would blend in.
+  ASSERT_TRUE(interpolate_refined_kd(grid, dark, 3, kd, true, 1e6f));
+  EXPECT_GT(kd.x(), 0.35f);
 }
 
 TEST(MaterialMaps, WithoutRefinedVoxelsAroundThePointTheSegmentsFusedRefinedAlbedoStands) {

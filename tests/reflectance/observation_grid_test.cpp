@@ -62,6 +62,32 @@ TEST(ObservationGrid, WallVoxelsLieOnTheWallAndFaceTheCamera) {
   }
 }
 
+TEST(ObservationGrid, FindVoxelsLooksUpACubeOfVoxelsAsFindVoxelDoes) {
+  fusion::TsdfVolume geometry(geometry_params());
+  fusion::VisibleBlocks blocks;
+  Wall wall;
+  fusion::integrate(geometry, wall.depth, wall.colour, kCamera, Pose::Identity(), blocks);
+  ObservationGrid grid(grid_params());
+  grid.collect(wall.depth, wall.colour, kCamera, Pose::Identity(), 1.0f, geometry, 0);
+  // Cubes straddling the wall (voxel z = 49 and 50 at 2 cm) at negative and positive x, y and
+  // block boundaries on either side of `first`; one far from it has no voxel.
+  int found = 0;
+  for (const Eigen::Vector3i& first : {Eigen::Vector3i(-3, -2, 48), Eigen::Vector3i(0, 1, 47),
+                                       Eigen::Vector3i(5, -6, 49), Eigen::Vector3i(-1, -1, 20)})
+    for (const int n : {1, 3, 4}) {
+      std::array<int, 64> voxels;
+      grid.find_voxels(first, n, voxels.data());
+      for (int z = 0; z < n; ++z)
+        for (int y = 0; y < n; ++y)
+          for (int x = 0; x < n; ++x) {
+            const int expected = grid.find_voxel(first + Eigen::Vector3i(x, y, z));
+            EXPECT_EQ(voxels[std::size_t((z * n + y) * n + x)], expected);
+            found += expected >= 0;
+          }
+    }
+  EXPECT_GT(found, 40);
+}
+
 TEST(ObservationGrid, OccludedAndFarVoxelsAreNotObserved) {
   fusion::TsdfVolume geometry(geometry_params());
   fusion::VisibleBlocks blocks;

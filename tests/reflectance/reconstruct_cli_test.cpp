@@ -48,6 +48,7 @@ TEST_F(ReconstructCli, WritesTheModelMaterialsLightsPicturesAndReport) {
   EXPECT_TRUE(report["evaluation"]["average"].contains("kd_ref"));
   EXPECT_GE(report["materials"]["segments"].size(), 2u);
   // --device auto: the GPU where this build has CUDA and there is one.
+  EXPECT_FLOAT_EQ(report["parameters"]["albedo_smoothing"].get<float>(), 0.2f);
   EXPECT_EQ(report["parameters"]["integration_device"],
             fusion::CudaIntegrator::available() ? "cuda" : "cpu");
   // The table is printed.
@@ -75,6 +76,10 @@ TEST_F(ReconstructCli, BadInputsFailClearly) {
                  "/scene.json -o " + path("x"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("scene.json"), std::string::npos) << result.output;
+  result =
+      glint("reconstruct " + path("seq") + " --gt-lights --albedo-smoothing -0.1 -o " + path("x"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("--albedo-smoothing"), std::string::npos) << result.output;
   result = glint("reconstruct " + path("seq") + " --gt-lights --device gpu -o " + path("x"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("--device"), std::string::npos) << result.output;
