@@ -150,7 +150,9 @@ void run_reconstruct(ReconstructOptions options) {
   reflectance::ReflectancePipeline pipeline(sequence.intrinsics, options.params, network,
                                             lights.lights);
   reflectance::MaterialEvaluation evaluation;
-  StageTimings command_timings;  // read, evaluate, render per frame; mesh once
+  // Per frame: read; render (the re-rendering alone), evaluate (scoring and pictures); per
+  // extra view: render; mesh once.
+  StageTimings command_timings;
   int lost = 0;
   {
     ProgressBar progress("reconstruct", frames);
@@ -178,6 +180,8 @@ void run_reconstruct(ReconstructOptions options) {
         const reflectance::MaterialMaps maps =
             render_model(pipeline, sequence.intrinsics, result.geometry.camera_to_world,
                          options.render_normal_radius_m);
+        command_timings.add("render", watch.elapsed_ms());
+        watch.restart();
         if (evaluate) evaluation.add_frame(int(i), maps, *truth, frame.colour);
         if (render) write_frame_pictures(options.output, int(i), frame.colour, maps);
         command_timings.add("evaluate", watch.elapsed_ms());
@@ -192,8 +196,10 @@ void run_reconstruct(ReconstructOptions options) {
     fs::create_directories(fs::path(options.output) / "views");
     ProgressBar progress("views", views.size());
     for (std::size_t k = 0; k < views.size(); ++k) {
+      Stopwatch watch;
       const reflectance::MaterialMaps maps = render_model(
           pipeline, sequence.intrinsics, views[k].pose, options.render_normal_radius_m);
+      command_timings.add("render", watch.elapsed_ms());
       write_view_pictures((fs::path(options.output) / "views").string(), int(k), maps);
       progress.advance();
     }

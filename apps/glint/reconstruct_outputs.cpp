@@ -52,20 +52,25 @@ void write_material_mesh(const std::string& path,
   std::array<std::vector<float>, 8> values;  // kd rgb, ks rgb, alpha, segment
   for (auto& v : values) v.assign(n, 0.0f);
   mesh.colours.assign(n, Eigen::Vector3f::Zero());
-  parallel_for(n, [&](std::size_t i) {
-    reflectance::PointMaterial material;
-    if (!reflectance::material_at(pipeline.observations(), pipeline.materials(), mesh.vertices[i],
-                                  material, pipeline.albedo_smoothing())) {
+  // Chunks of consecutive vertices (marching cubes emits them block by block), so that each
+  // lookup mostly finds its neighbourhood kept from the vertex before.
+  parallel_for_chunks(n, 1024, [&](std::size_t begin, std::size_t end) {
+    reflectance::MaterialLookup lookup(pipeline.observations(), pipeline.materials(),
+                                       pipeline.albedo_smoothing());
+    for (std::size_t i = begin; i < end; ++i) {
+      reflectance::PointMaterial material;
+      if (!lookup(mesh.vertices[i], material)) {
+        values[7][i] = float(material.segment);
+        continue;
+      }
+      mesh.colours[i] = material.refined.kd;
+      for (int c = 0; c < 3; ++c) {
+        values[c][i] = material.refined.kd[c];
+        values[3 + c][i] = material.fused.ks[c];
+      }
+      values[6][i] = material.fused.alpha;
       values[7][i] = float(material.segment);
-      return;
     }
-    mesh.colours[i] = material.refined.kd;
-    for (int c = 0; c < 3; ++c) {
-      values[c][i] = material.refined.kd[c];
-      values[3 + c][i] = material.fused.ks[c];
-    }
-    values[6][i] = material.fused.alpha;
-    values[7][i] = float(material.segment);
   });
   const std::array<const char*, 8> names{"kd_r", "kd_g", "kd_b",  "ks_r",
                                          "ks_g", "ks_b", "alpha", "scalar_segment"};

@@ -74,71 +74,80 @@ bool blend_without_outliers(const WeightedAlbedos& around, Eigen::Vector3f& kd) 
   return true;
 }
 
-// The 4^3 observation voxels around a point: the 8 corners of its trilinear cell and one voxel
-// further out on every side; pool indices of the segment's voxels with a refined albedo, -1 for
-// the others.
-struct RefinedNeighbourhood {
-  Eigen::Vector3f t;  // the point's trilinear coordinates within the cell, in [0, 1)^3
-  std::array<int, 64> voxels;
-
-  RefinedNeighbourhood(const ObservationGrid& grid, const Eigen::Vector3f& p, int segment) {
-    // Voxel centres sit at (i + 0.5) * size: the 8 around p start at floor(p / size - 0.5).
-    const Eigen::Vector3f g =
-        p / float(grid.params().voxel_size_m) - Eigen::Vector3f::Constant(0.5f);
-    const Eigen::Vector3i base(int(std::floor(g.x())), int(std::floor(g.y())),
-                               int(std::floor(g.z())));
-    t = g - base.cast<float>();
-    grid.find_voxels(base - Eigen::Vector3i::Ones(), 4, voxels.data());
-    for (int& v : voxels)
-      if (v >= 0 && !(grid.segment(v) == segment && grid.has_refined_kd(v))) v = -1;
-  }
-  // The voxel at offset (dx, dy, dz) from the cell's first corner, each in [-1, 2].
-  int at(int dx, int dy, int dz) const { return voxels[((dz + 1) * 4 + dy + 1) * 4 + dx + 1]; }
-  // Its weight under a tent twice the voxel's width centred on the point.
-  float wide_tent(int dx, int dy, int dz) const {
-    const Eigen::Vector3f d = (t - Eigen::Vector3f(dx, dy, dz)).cwiseAbs();
-    return (1 - 0.5f * d.x()) * (1 - 0.5f * d.y()) * (1 - 0.5f * d.z());
-  }
-  // visit(v, dx, dy, dz) for each of the 4^3 voxels with a reliable refined albedo.
-  template <class Visit>
-  void for_each_reliable(const ObservationGrid& grid, Visit&& visit) const {
-    for (int dz = -1; dz <= 2; ++dz)
-      for (int dy = -1; dy <= 2; ++dy)
-        for (int dx = -1; dx <= 2; ++dx) {
-          const int v = at(dx, dy, dz);
-          if (v >= 0 && grid.refined_kd_reliable(v)) visit(v, dx, dy, dz);
-        }
-  }
+// The trilinear cell of point p: its first corner voxel and p's coordinates within it in
+// [0, 1)^3. Voxel centres sit at (i + 0.5) * size: the 8 around p start at floor(p / size - 0.5).
+struct Cell {
+  Eigen::Vector3i base;
+  Eigen::Vector3f t;
 };
+Cell cell_of(const ObservationGrid& grid, const Eigen::Vector3f& p) {
+  const Eigen::Vector3f g = p / float(grid.params().voxel_size_m) - Eigen::Vector3f::Constant(0.5f);
+  const Eigen::Vector3i base(int(std::floor(g.x())), int(std::floor(g.y())),
+                             int(std::floor(g.z())));
+  return {base, g - base.cast<float>()};
+}
 
-// Joint bilateral smoothing (Tomasi and Manduchi 1998) of the albedo kd interpolated at a point:
-// the reliable voxels of its 4^3 under the wide tent, each weighted further by exp(-r^2 / 2),
-// r = its mean absolute channel difference from kd over contrast * (mean of kd + 0.01). The
-// voxel-to-voxel scatter of eq. (7) averages out; a texture edge of more contrast is kept.
+// Fills `around` for the cell at `base` and `segment`, unless it holds them already.
+void look_up(const ObservationGrid& grid, const Eigen::Vector3i& base, int segment,
+             RefinedNeighbourhood& around) {
+  if (around.segment == segment && around.base == base) return;
+  around.base = base;
+  around.segment = segment;
+  grid.find_voxels(base - Eigen::Vector3i::Ones(), 4, around.voxels.data());
+  for (int& v : around.voxels)
+    if (v >= 0 && !(grid.segment(v) == segment && grid.has_refined_kd(v))) v = -1;
+}
+
+// The voxel at offset (dx, dy, dz) from the cell's first corner, each in [-1, 2].
+int voxel_at(const RefinedNeighbourhood& around, int dx, int dy, int dz) {
+  return around.voxels[std::size_t(((dz + 1) * 4 + dy + 1) * 4 + dx + 1)];
+}
+
+// Its weight under a tent twice the voxel's width centred on the point at t in the cell.
+float wide_tent(const Eigen::Vector3f& t, int dx, int dy, int dz) {
+  const Eigen::Vector3f d = (t - Eigen::Vector3f(dx, dy, dz)).cwiseAbs();
+  return (1 - 0.5f * d.x()) * (1 - 0.5f * d.y()) * (1 - 0.5f * d.z());
+}
+
+// visit(v, dx, dy, dz) for each of the 4^3 voxels with a reliable refined albedo.
+template <class Visit>
+void for_each_reliable(const ObservationGrid& grid, const RefinedNeighbourhood& around,
+                       Visit&& visit) {
+  for (int dz = -1; dz <= 2; ++dz)
+    for (int dy = -1; dy <= 2; ++dy)
+      for (int dx = -1; dx <= 2; ++dx) {
+        const int v = voxel_at(around, dx, dy, dz);
+        if (v >= 0 && grid.refined_kd_reliable(v)) visit(v, dx, dy, dz);
+      }
+}
+
+// Joint bilateral smoothing (Tomasi and Manduchi 1998) of the albedo kd interpolated at the point
+// at t: the reliable voxels of its 4^3 under the wide tent, each weighted further by
+// exp(-r^2 / 2), r = its mean absolute channel difference from kd over contrast * (mean of kd +
+// 0.01). The voxel-to-voxel scatter of eq. (7) averages out; a texture edge of more contrast is
+// kept.
 void smooth_refined_kd(const ObservationGrid& grid, const RefinedNeighbourhood& around,
-                       float contrast, Eigen::Vector3f& kd) {
+                       const Eigen::Vector3f& t, float contrast, Eigen::Vector3f& kd) {
   const Eigen::Vector3f reference = kd;
   const float inverse_scale = 1.0f / (contrast * (reference.mean() + 0.01f));
   Eigen::Vector3f sum = Eigen::Vector3f::Zero();
   float weights = 0;
-  around.for_each_reliable(grid, [&](int v, int dx, int dy, int dz) {
+  for_each_reliable(grid, around, [&](int v, int dx, int dy, int dz) {
     const float r = (grid.refined_kd(v) - reference).cwiseAbs().mean() * inverse_scale;
-    const float weight = around.wide_tent(dx, dy, dz) * std::exp(-0.5f * r * r);
+    const float weight = wide_tent(t, dx, dy, dz) * std::exp(-0.5f * r * r);
     sum += weight * grid.refined_kd(v);
     weights += weight;
   });
   if (weights > 1e-6f) kd = sum / weights;
 }
 
-}  // namespace
-
-bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& p, int segment,
-                            Eigen::Vector3f& kd, bool unreliable_corners, float smoothing) {
-  const RefinedNeighbourhood around(grid, p, segment);
-  const Eigen::Vector3f& t = around.t;
+// interpolate_refined_kd() at the point at t in the cell of `around`.
+bool interpolate(const ObservationGrid& grid, const RefinedNeighbourhood& around,
+                 const Eigen::Vector3f& t, Eigen::Vector3f& kd, bool unreliable_corners,
+                 float smoothing) {
   WeightedAlbedos reliable, unreliable;
   for (int c = 0; c < 8; ++c) {
-    const int v = around.at(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+    const int v = voxel_at(around, c & 1, (c >> 1) & 1, (c >> 2) & 1);
     if (v < 0) continue;
     const float weight = ((c & 1) ? t.x() : 1 - t.x()) * (((c >> 1) & 1) ? t.y() : 1 - t.y()) *
                          (((c >> 2) & 1) ? t.z() : 1 - t.z());
@@ -146,14 +155,24 @@ bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& 
   }
   if (reliable.count == 0) {
     // No corner is reliable: the reliable voxels one further out, under a tent twice as wide.
-    around.for_each_reliable(grid, [&](int v, int dx, int dy, int dz) {
-      reliable.add(around.wide_tent(dx, dy, dz), grid.refined_kd(v));
+    for_each_reliable(grid, around, [&](int v, int dx, int dy, int dz) {
+      reliable.add(wide_tent(t, dx, dy, dz), grid.refined_kd(v));
     });
   }
   if (reliable.count == 0 && !unreliable_corners) return false;
   if (!blend_without_outliers(reliable.count > 0 ? reliable : unreliable, kd)) return false;
-  if (smoothing > 0) smooth_refined_kd(grid, around, smoothing, kd);
+  if (smoothing > 0) smooth_refined_kd(grid, around, t, smoothing, kd);
   return true;
+}
+
+}  // namespace
+
+bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& p, int segment,
+                            Eigen::Vector3f& kd, bool unreliable_corners, float smoothing) {
+  const Cell cell = cell_of(grid, p);
+  RefinedNeighbourhood around;
+  look_up(grid, cell.base, segment, around);
+  return interpolate(grid, around, cell.t, kd, unreliable_corners, smoothing);
 }
 
 namespace {
@@ -182,16 +201,21 @@ int segment_at(const ObservationGrid& grid, const Eigen::Vector3f& p) {
 
 }  // namespace
 
-bool material_at(const ObservationGrid& grid, const SpecularEstimator& materials,
-                 const Eigen::Vector3f& p, PointMaterial& material, float albedo_smoothing) {
-  material.segment = segment_at(grid, p);
-  const SegmentMaterial* fused = materials.material(material.segment);
+bool MaterialLookup::operator()(const Eigen::Vector3f& p, PointMaterial& material) {
+  material.segment = segment_at(grid_, p);
+  const SegmentMaterial* fused = materials_.material(material.segment);
   if (!fused) return false;
   material.fused = material.refined = fused->ward;
   if (fused->kd_refined) material.refined.kd = *fused->kd_refined;
-  interpolate_refined_kd(grid, p, material.segment, material.refined.kd, !fused->kd_refined,
-                         albedo_smoothing);
+  const Cell cell = cell_of(grid_, p);
+  look_up(grid_, cell.base, material.segment, around_);
+  interpolate(grid_, around_, cell.t, material.refined.kd, !fused->kd_refined, albedo_smoothing_);
   return true;
+}
+
+bool material_at(const ObservationGrid& grid, const SpecularEstimator& materials,
+                 const Eigen::Vector3f& p, PointMaterial& material, float albedo_smoothing) {
+  return MaterialLookup(grid, materials, albedo_smoothing)(p, material);
 }
 
 namespace {
@@ -214,6 +238,7 @@ MaterialMaps render_material_maps(const fusion::SurfaceView& surface, const Pose
   const Eigen::Vector3f eye = camera_to_world.translation().cast<float>();
   parallel_for(std::size_t(height), [&](std::size_t row) {
     const int y = int(row);
+    MaterialLookup lookup(grid, materials, albedo_smoothing);
     for (int x = 0; x < width; ++x) {
       if (!(surface.depth_m.at(x, y, 0) > 0)) continue;
       const Eigen::Vector3f p(surface.points_m.at(x, y, 0), surface.points_m.at(x, y, 1),
@@ -222,7 +247,7 @@ MaterialMaps render_material_maps(const fusion::SurfaceView& surface, const Pose
                               surface.normals.at(x, y, 2));
       if (!p.allFinite() || !n.allFinite()) continue;
       PointMaterial material;
-      if (!material_at(grid, materials, p, material, albedo_smoothing)) continue;
+      if (!lookup(p, material)) continue;
       maps.segment.at(x, y, 0) = material.segment;
       maps.covered.at(x, y, 0) = 1;
       put(maps.kd, x, y, material.fused.kd);

@@ -7,7 +7,9 @@
 // pixel is shaded with the Ward BRDF under the estimated near-field point lights (direct light,
 // no shadows, as the albedo refinement assumes), once with the HemiCNN's kd and once with the
 // refined kd.
+#include <array>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "core/camera.h"
@@ -63,6 +65,32 @@ struct PointMaterial {
 };
 bool material_at(const ObservationGrid& grid, const SpecularEstimator& materials,
                  const Eigen::Vector3f& p, PointMaterial& material, float albedo_smoothing = 0);
+
+// The refined albedos of one segment's voxels in the 4^3 around a trilinear cell (from the
+// cell's first corner - 1, x fastest): pool indices, -1 where no voxel of the segment has one.
+struct RefinedNeighbourhood {
+  Eigen::Vector3i base = Eigen::Vector3i::Constant(std::numeric_limits<int>::min());
+  int segment = -1;
+  std::array<int, 64> voxels{};
+};
+
+// material_at() for many points of one model, such as a re-rendering's pixels or a mesh's
+// vertices, in an order where neighbours follow each other: it keeps the last point's
+// refined-albedo neighbourhood (64 voxels and a hash look-up per block they touch), which the
+// next point mostly shares. One per thread; the grid must not change while it is in use.
+class MaterialLookup {
+ public:
+  MaterialLookup(const ObservationGrid& grid, const SpecularEstimator& materials,
+                 float albedo_smoothing = 0)
+      : grid_(grid), materials_(materials), albedo_smoothing_(albedo_smoothing) {}
+  bool operator()(const Eigen::Vector3f& p, PointMaterial& material);
+
+ private:
+  const ObservationGrid& grid_;
+  const SpecularEstimator& materials_;
+  float albedo_smoothing_;
+  RefinedNeighbourhood around_;
+};
 
 MaterialMaps render_material_maps(const fusion::SurfaceView& surface, const Pose& camera_to_world,
                                   const ObservationGrid& grid, const SpecularEstimator& materials,

@@ -1,6 +1,6 @@
 // Re-rendering: Ward shading under point lights against the formula, the refined albedo's
-// interpolation between observation voxels of one segment, and the segment's refined albedo
-// where no voxel around has one.
+// interpolation and smoothing between observation voxels of one segment, the segment's refined
+// albedo where no voxel around has one, and MaterialLookup's kept neighbourhoods.
 #include "reflectance/material_maps.h"
 
 #include <gtest/gtest.h>
@@ -177,7 +177,7 @@ TEST(MaterialMaps, SmoothingAveragesTheScatterOfUniformAlbedosButKeepsATextureEd
   EXPECT_GT(kd.x(), 0.35f);
 }
 
-TEST(MaterialMaps, WithoutRefinedVoxelsAroundThePointTheSegmentsFusedRefinedAlbedoStands) {
+TEST(MaterialMaps, SegmentsRefinedAlbedoStandsWithoutVoxelsAndALookupAgreesWithMaterialAt) {
   Wall wall;
   ObservationGrid& grid = wall.grid();
   SegmentMap segments;
@@ -218,6 +218,32 @@ TEST(MaterialMaps, WithoutRefinedVoxelsAroundThePointTheSegmentsFusedRefinedAlbe
                    [](const Eigen::Vector3f&) { return false; });
   ASSERT_TRUE(material_at(grid, estimator, p, material));
   EXPECT_TRUE(material.refined.kd.isApprox(segment_kd, 1e-6f));
+
+  // A lookup that keeps the last point's neighbourhood gives what a fresh one gives, point by
+  // point along a sweep that crosses cells and a strip of voxels relabelled to a segment
+  // without a material.
+  wall.with_albedo([](const Eigen::Vector3f& q) {
+    return Eigen::Vector3f(0.3f + q.x(), 0.4f - q.y(), 0.5f + 0.1f * std::sin(300 * q.x()));
+  });
+  for (const VisibleVoxel& seen : wall.visible())
+    if (std::abs(grid.position(seen.voxel).x() - 0.05f) < 0.015f) grid.segment(seen.voxel) = 5;
+  MaterialLookup lookup(grid, estimator, 0.2f);
+  int found = 0, missing = 0;
+  for (float x = -0.12f; x <= 0.12f; x += 0.0037f) {
+    const Eigen::Vector3f q(x, 0.011f - 0.3f * x, 1.005f);
+    PointMaterial kept, fresh;
+    const bool with_material = lookup(q, kept);
+    ASSERT_EQ(with_material, material_at(grid, estimator, q, fresh, 0.2f)) << x;
+    EXPECT_EQ(kept.segment, fresh.segment) << x;
+    if (!with_material) {
+      ++missing;
+      continue;
+    }
+    ++found;
+    EXPECT_EQ(kept.refined.kd, fresh.refined.kd) << x;
+  }
+  EXPECT_GT(found, 40);
+  EXPECT_GT(missing, 3);
 }
 
 }  // namespace
