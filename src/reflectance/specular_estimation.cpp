@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "core/error.h"
 #include "core/log.h"
 #include "render/perceptual.h"
 
@@ -41,6 +42,9 @@ float fit_weight(const SpecularFit& fit) {
 
 SpecularEstimator::SpecularEstimator(const HemiCnn& network, const SpecularParams& params)
     : network_(network), params_(params) {
+  if (params.voxels_per_estimate < 1 || params.min_distinct_voxels < 1)
+    throw Error("specular estimation", "voxels_per_estimate",
+                "voxels_per_estimate and min_distinct_voxels must be >= 1");
   hemi_.projection = network.projection();
 }
 
@@ -71,12 +75,13 @@ void SpecularEstimator::update(const ObservationGrid& grid, const SegmentMap& se
     std::vector<int> voxels(count);
     const int sampled = segment_map.sample(grid, segments[i], count, params_.min_observations,
                                            random, voxels.data());
-    if (sampled < count) {
+    if (sampled < std::min(count, params_.min_distinct_voxels)) {
       log().debug("frame {}: segment {} has {} of {} voxels with {} observations (reservoir {})",
                   frame, segments[i], sampled, count, params_.min_observations,
                   segment_map.reservoir_size(segments[i]));
       return;
     }
+    for (int k = sampled; k < count; ++k) voxels[std::size_t(k)] = voxels[std::size_t(k % sampled)];
     std::vector<float> images(std::size_t(count) * image_floats);
     for (int k = 0; k < count; ++k)
       make_hemi_image(grid.observations(voxels[k]), grid.observation_count(voxels[k]),

@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include "core/error.h"
 #include "fusion/integrate.h"
 #include "reflectance/segment_map.h"
 
@@ -244,6 +245,37 @@ TEST(MaterialMaps, SegmentsRefinedAlbedoStandsWithoutVoxelsAndALookupAgreesWithM
   }
   EXPECT_GT(found, 40);
   EXPECT_GT(missing, 3);
+}
+
+// (The specular stage's sampling, here for the Wall.) A segment with fewer qualifying voxels
+// than the network's 25 branches repeats them, from min_distinct_voxels on.
+TEST(SpecularEstimator, SmallSegmentsRepeatTheirVoxelsToFillTheBranches) {
+  Wall wall;
+  ObservationGrid& grid = wall.grid();
+  ASSERT_GT(wall.voxels(), 40u);
+  SegmentMap segments;
+  segments.update(grid, wall.visible(), Image<std::int32_t>(80, 60, 1, 3), true);
+  const HemiCnn network;
+  std::vector<render::PointLight> lights(1);
+  // Only the first `distinct` voxels keep segment 3 (sampling skips voxels that left it).
+  const auto material_with = [&](int distinct, int min_distinct) {
+    for (std::size_t k = 0; k < wall.visible().size(); ++k)
+      grid.segment(wall.visible()[k].voxel) = int(k) < distinct ? 3 : 4;
+    SpecularParams params;
+    params.min_observations = 1;
+    params.min_distinct_voxels = min_distinct;
+    params.fit_lobe = false;
+    SpecularEstimator estimator(network, params);
+    estimator.update(grid, segments, {3}, lights, 0);
+    return estimator.material(3) != nullptr;
+  };
+  EXPECT_TRUE(material_with(25, 25));
+  EXPECT_FALSE(material_with(10, 25)) << "the paper's sampling: 25 distinct voxels";
+  EXPECT_TRUE(material_with(10, 8));
+  EXPECT_FALSE(material_with(7, 8));
+  SpecularParams none;
+  none.min_distinct_voxels = 0;
+  EXPECT_THROW(SpecularEstimator(network, none), Error);
 }
 
 }  // namespace
