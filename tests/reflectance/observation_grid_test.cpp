@@ -62,13 +62,21 @@ TEST(ObservationGrid, WallVoxelsLieOnTheWallAndFaceTheCamera) {
   }
 }
 
+// The wall fused and observed once from the origin.
+struct ObservedWall {
+  fusion::TsdfVolume geometry{geometry_params()};
+  ObservationGrid grid{grid_params()};
+  ObservedWall() {
+    const Wall wall;
+    fusion::VisibleBlocks blocks;
+    fusion::integrate(geometry, wall.depth, wall.colour, kCamera, Pose::Identity(), blocks);
+    grid.collect(wall.depth, wall.colour, kCamera, Pose::Identity(), 1.0f, geometry, 0);
+  }
+};
+
 TEST(ObservationGrid, FindVoxelsLooksUpACubeOfVoxelsAsFindVoxelDoes) {
-  fusion::TsdfVolume geometry(geometry_params());
-  fusion::VisibleBlocks blocks;
-  Wall wall;
-  fusion::integrate(geometry, wall.depth, wall.colour, kCamera, Pose::Identity(), blocks);
-  ObservationGrid grid(grid_params());
-  grid.collect(wall.depth, wall.colour, kCamera, Pose::Identity(), 1.0f, geometry, 0);
+  const ObservedWall observed;
+  const ObservationGrid& grid = observed.grid;
   // Cubes straddling the wall (voxel z = 49 and 50 at 2 cm) at negative and positive x, y and
   // block boundaries on either side of `first`; one far from it has no voxel.
   int found = 0;
@@ -89,17 +97,13 @@ TEST(ObservationGrid, FindVoxelsLooksUpACubeOfVoxelsAsFindVoxelDoes) {
 }
 
 TEST(ObservationGrid, OccludedAndFarVoxelsAreNotObserved) {
-  fusion::TsdfVolume geometry(geometry_params());
-  fusion::VisibleBlocks blocks;
-  Wall wall;
-  fusion::integrate(geometry, wall.depth, wall.colour, kCamera, Pose::Identity(), blocks);
-  ObservationGrid grid(grid_params());
-  grid.collect(wall.depth, wall.colour, kCamera, Pose::Identity(), 1.0f, geometry, 0);
+  ObservedWall observed;
+  ObservationGrid& grid = observed.grid;
   // Now an occluder at 0.6 m covers the view: the wall's voxels fail the depth test.
   Wall occluder;
   occluder.depth = ImageF(kCamera.width, kCamera.height, 1, 0.6f);
-  const auto& visible =
-      grid.collect(occluder.depth, occluder.colour, kCamera, Pose::Identity(), 1.0f, geometry, 1);
+  const auto& visible = grid.collect(occluder.depth, occluder.colour, kCamera, Pose::Identity(),
+                                     1.0f, observed.geometry, 1);
   for (const VisibleVoxel& seen : visible) EXPECT_NEAR(grid.position(seen.voxel).z(), 0.6f, 0.05f);
   int wall_observations = 0;
   for (int v = 0; v < int(grid.voxel_count()); ++v)
