@@ -57,8 +57,8 @@ bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& 
 // labelled neighbour voxel), its fused Ward parameters, and the same with the refined kd (the
 // segment's fused refined kd where interpolate_refined_kd finds no reliable voxel; before the
 // segment has one, the unreliable voxels around p, else the network's kd), smoothed as
-// interpolate_refined_kd() with `albedo_smoothing`. False when p lies in no segment with a material
-// yet.
+// interpolate_refined_kd() with `albedo_smoothing`. False when p lies in no segment with a
+// material yet.
 struct PointMaterial {
   int segment = 0;
   render::WardMaterial fused, refined;

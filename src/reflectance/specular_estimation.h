@@ -1,6 +1,7 @@
 #pragma once
 // Per-segment Ward parameters (paper 1 §3.6): every frame, each segment seen in it samples
-// voxels_per_estimate (25) of its voxels from its ring buffer, turns their observations into
+// voxels_per_estimate (25) of its voxels from its ring buffer (repeating them where it has
+// fewer, but at least min_distinct_voxels), turns their observations into
 // HemiImages, and the HemiCNN predicts one material from the set. The per-frame estimates are
 // fused over time by a running mean whose divisor is clamped (60), per Ward parameter.
 // With fit_lobe (glint's addition, reflectance/specular_fit.h) a photometric fit of the Ward
