@@ -215,14 +215,19 @@ void ObservationGrid::allocate(const ImageF& depth_m, const Intrinsics& intrinsi
   const float inverse_block = float(1.0 / params_.block_size_m);
   const Eigen::Matrix3f rotation = camera_to_world.linear().cast<float>();
   const Eigen::Vector3f translation = camera_to_world.translation().cast<float>();
-  std::atomic<bool> pool_full{false};
-  const int rows = (depth_m.height() + stride - 1) / stride;
-  frame_blocks_.clear();
-  tbb::enumerable_thread_specific<std::vector<int>> local_blocks;
+  const std::size_t rows = std::size_t((depth_m.height() + stride - 1) / stride);
+  // The blocks under each chunk of rows, and their pool indices (kAbsent: new), found in
+  // parallel; the new ones are then inserted, and the frame's blocks listed, in row order on one
+  // thread. Pool indices, and so the order of the frame's voxels that the segments' reservoirs
+  // and samples follow, then do not depend on how the threads were scheduled: a run gives the
+  // same result on any number of threads.
+  constexpr std::size_t kRowsPerChunk = 4;
+  chunk_blocks_.resize((rows + kRowsPerChunk - 1) / kRowsPerChunk);
   tbb::enumerable_thread_specific<std::vector<Eigen::Vector3i>> buffers;
-  parallel_for_chunks(std::size_t(rows), 4, [&](std::size_t row_begin, std::size_t row_end) {
+  parallel_for(chunk_blocks_.size(), [&](std::size_t chunk) {
     fusion::PendingBlocks pending(hash_, buffers.local());
-    for (std::size_t row = row_begin; row < row_end; ++row) {
+    for (std::size_t row = chunk * kRowsPerChunk; row < std::min(rows, (chunk + 1) * kRowsPerChunk);
+         ++row) {
       const int y = int(row) * stride;
       for (int x = 0; x < depth_m.width(); x += stride) {
         const float z = depth_m.at(x, y, 0);
@@ -233,23 +238,24 @@ void ObservationGrid::allocate(const ImageF& depth_m, const Intrinsics& intrinsi
         pending.add(int(std::floor(b.x())), int(std::floor(b.y())), int(std::floor(b.z())));
       }
     }
-    std::vector<int>& mine = local_blocks.local();
-    for (const Eigen::Vector3i& block : pending.blocks()) {
-      const auto insertion = hash_.insert(block);
-      if (insertion.index < 0) {
-        pool_full = true;
-        return;
-      }
-      if (block_last_frame_[insertion.index].exchange(frame, std::memory_order_relaxed) != frame)
-        mine.push_back(insertion.index);
-    }
+    std::vector<std::pair<Eigen::Vector3i, int>>& found = chunk_blocks_[chunk];
+    found.clear();
+    for (const Eigen::Vector3i& block : pending.blocks())
+      found.emplace_back(block, hash_.find(block));
   });
-  if (pool_full)
-    throw Error("observation grid", "voxel_capacity",
-                "pool of " + std::to_string(hash_.capacity() * voxels_per_block_) +
-                    " voxels is exhausted; raise it (--obs-voxels) or use a coarser grid");
-  for (const auto& mine : local_blocks)
-    frame_blocks_.insert(frame_blocks_.end(), mine.begin(), mine.end());
+  frame_blocks_.clear();
+  for (const auto& found : chunk_blocks_)
+    for (auto [block, index] : found) {
+      if (index == fusion::VoxelBlockHash::kAbsent) {
+        index = hash_.insert(block).index;
+        if (index < 0)
+          throw Error("observation grid", "voxel_capacity",
+                      "pool of " + std::to_string(hash_.capacity() * voxels_per_block_) +
+                          " voxels is exhausted; raise it (--obs-voxels) or use a coarser grid");
+      }
+      if (block_last_frame_[index].exchange(frame, std::memory_order_relaxed) != frame)
+        frame_blocks_.push_back(index);
+    }
 }
 
 void ObservationGrid::refresh_surface(int v, const Eigen::Vector3f& centre, int frame,

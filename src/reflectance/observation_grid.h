@@ -26,6 +26,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "core/camera.h"
@@ -197,6 +198,8 @@ class ObservationGrid {
   fusion::VoxelBlockHash hash_;
   std::unique_ptr<std::atomic<int>[]> block_last_frame_;
   std::vector<int> frame_blocks_;
+  // allocate()'s scratch: per chunk of depth rows, its blocks and their pool indices.
+  std::vector<std::vector<std::pair<Eigen::Vector3i, int>>> chunk_blocks_;
   // Per frame block: whether a refresh in this frame found a surface in one of its voxels (the
   // blocks whose normals are refitted), and the slots of those blocks.
   std::vector<std::uint8_t> block_refreshed_;

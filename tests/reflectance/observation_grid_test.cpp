@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "fusion/integrate.h"
 #include "support/error_of.h"
 
@@ -110,6 +111,40 @@ TEST(ObservationGrid, OccludedAndFarVoxelsAreNotObserved) {
     if (grid.has_surface(v) && std::abs(grid.position(v).z() - 1.0f) < 0.01f)
       wall_observations = std::max(wall_observations, grid.observation_count(v));
   EXPECT_EQ(wall_observations, 1) << "the occluded wall got no second observation";
+}
+
+// Pool indices, and with them the order of a frame's voxels (which the segments' reservoirs and
+// samples follow), are handed out in image-row order whatever the threads do.
+TEST(ObservationGrid, VoxelIndicesDoNotDependOnTheNumberOfThreads) {
+  // A tilted wall seen from three poses: every frame allocates new blocks.
+  const auto run = [](int threads) {
+    const auto limit = limit_threads(threads);
+    fusion::TsdfVolume geometry(geometry_params());
+    ObservationGridParams params = grid_params();
+    params.voxel_capacity = 1 << 17;
+    ObservationGrid grid(params);
+    ImageF depth(kCamera.width, kCamera.height, 1);
+    for (int y = 0; y < kCamera.height; ++y)
+      for (int x = 0; x < kCamera.width; ++x) depth.at(x, y, 0) = 0.8f + 0.006f * float(x);
+    const ImageF colour(kCamera.width, kCamera.height, 3, 0.25f);
+    std::vector<VisibleVoxel> all;
+    for (int frame = 0; frame < 3; ++frame) {
+      Pose pose = Pose::Identity();
+      pose.translation() = Eigen::Vector3d(0.15 * frame, 0.05 * frame, 0);
+      fusion::VisibleBlocks blocks;
+      fusion::integrate(geometry, depth, colour, kCamera, pose, blocks);
+      const auto& visible = grid.collect(depth, colour, kCamera, pose, 1.0f, geometry, frame);
+      all.insert(all.end(), visible.begin(), visible.end());
+    }
+    return all;
+  };
+  const std::vector<VisibleVoxel> one = run(1), many = run(0);
+  ASSERT_GT(one.size(), 100u);
+  ASSERT_EQ(one.size(), many.size());
+  for (std::size_t i = 0; i < one.size(); ++i) {
+    EXPECT_EQ(one[i].voxel, many[i].voxel) << i;
+    EXPECT_EQ(one[i].pixel, many[i].pixel) << i;
+  }
 }
 
 TEST(ObservationGrid, ObservationsAccumulateUpToTheCapacity) {
