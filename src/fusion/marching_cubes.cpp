@@ -2,12 +2,14 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <climits>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numeric>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -176,9 +178,20 @@ TriangleMesh extract_mesh(const TsdfVolume& volume) {
   std::vector<BlockEdges> edges(blocks);
   parallel_for(blocks, [&](std::size_t block) { edges[block] = count_block(volume, int(block)); });
 
+  // Vertices and triangles are laid out in the order of the blocks' coordinates, not of their
+  // pool indices, which depend on how the threads happened to allocate them: a volume gives the
+  // same mesh file on any number of threads.
+  std::vector<std::uint64_t> keys(blocks);
+  for (std::size_t block = 0; block < blocks; ++block) {
+    const Eigen::Vector3i b = volume.hash().block(int(block));
+    keys[block] = pack_block_key(b.x(), b.y(), b.z());
+  }
+  std::vector<int> order(blocks);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return keys[a] < keys[b]; });
   std::vector<int> vertex_begin(blocks), triangle_begin(blocks);
   std::int64_t vertices = 0, triangles = 0;
-  for (std::size_t block = 0; block < blocks; ++block) {
+  for (const int block : order) {
     vertex_begin[block] = int(vertices);
     triangle_begin[block] = int(triangles);
     vertices += edges[block].vertices;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 #include "core/error.h"
@@ -64,12 +65,16 @@ void ReflectancePipeline::refine_albedo_of_visible() {
   // with its data in cache), so each chunk runs a two-stage prefetch: a voxel's own state
   // kVoxelAhead iterations early, then, once that has arrived, its observations.
   constexpr std::size_t kVoxelAhead = 8, kObservationsAhead = 3;
-  // Per thread and segment: the sum of the reliable refined kd (rgb) and their count.
+  // Per thread and segment: the sum of the reliable refined kd (rgb) and their count. The sums
+  // are in fixed point (kd in [0, 1] in steps of 2^-24), so that they add up to the same total
+  // whichever thread took which voxels: a run's result does not depend on the scheduling.
+  using FixedSums = Eigen::Matrix<std::int64_t, 4, 1>;
+  constexpr double kFixedOne = double(1 << 24);
   const int segments = segment_map_.max_segment_id() + 1;
-  tbb::enumerable_thread_specific<std::vector<Eigen::Vector4f>> sums(std::size_t(segments),
-                                                                     Eigen::Vector4f::Zero());
+  tbb::enumerable_thread_specific<std::vector<FixedSums>> sums(std::size_t(segments),
+                                                               FixedSums::Zero());
   parallel_for_chunks(albedo_due_.size(), 64, [&](std::size_t begin, std::size_t end) {
-    std::vector<Eigen::Vector4f>& segment_sums = sums.local();
+    std::vector<FixedSums>& segment_sums = sums.local();
     for (std::size_t i = begin; i < std::min(begin + kVoxelAhead, end); ++i)
       grid_.prefetch_voxel(albedo_due_[i]);
     for (std::size_t i = begin; i < end; ++i) {
@@ -88,16 +93,22 @@ void ReflectancePipeline::refine_albedo_of_visible() {
       if (!refined) continue;
       grid_.refined_kd(v) = refined->kd.cwiseMax(0.0f).cwiseMin(1.0f);
       grid_.refined_kd_reliable(v) = refined->light_cosine >= params_.albedo_min_light_cosine;
-      if (grid_.refined_kd_reliable(v) && segment < segments)
-        segment_sums[segment] += (Eigen::Vector4f() << grid_.refined_kd(v), 1.0f).finished();
+      if (grid_.refined_kd_reliable(v) && segment < segments) {
+        const Eigen::Vector3f& kd = grid_.refined_kd(v);
+        segment_sums[segment] +=
+            FixedSums(std::llround(kd.x() * kFixedOne), std::llround(kd.y() * kFixedOne),
+                      std::llround(kd.z() * kFixedOne), 1);
+      }
     }
   });
   // Each segment's mean over its voxels solved reliably in this frame, into its
   // SegmentMaterial::kd_refined.
   for (int segment = 1; segment < segments; ++segment) {
-    Eigen::Vector4f sum = Eigen::Vector4f::Zero();
+    FixedSums sum = FixedSums::Zero();
     for (const auto& local : sums) sum += local[segment];
-    if (sum.w() > 0) specular_.fuse_refined_albedo(segment, sum.head<3>() / sum.w());
+    if (sum.w() > 0)
+      specular_.fuse_refined_albedo(
+          segment, (sum.head<3>().cast<double>() / (kFixedOne * double(sum.w()))).cast<float>());
   }
 }
 

@@ -82,6 +82,26 @@ TEST(MarchingCubes, TheMeshIsTheSameWhateverTheThreadCount) {
   EXPECT_EQ(parallel.triangles, serial.triangles);
 }
 
+TEST(MarchingCubes, TheMeshIsTheSameWhateverOrderTheBlocksWereAllocatedIn) {
+  // Threads allocate a frame's blocks in no fixed order; the mesh follows block coordinates.
+  VolumeParams params;
+  params.voxel_size_m = 0.01;
+  params.block_capacity = 20000;
+  const auto sphere = [](const Eigen::Vector3d& p) { return p.norm() - 0.25; };
+  TsdfVolume forward(params), backward(params);
+  test::fill_analytic(forward, sphere, 0.3, 0.04);
+  // The same blocks allocated in the reverse order first.
+  for (int b = int(forward.block_count()) - 1; b >= 0; --b)
+    backward.allocate(forward.hash().block(b));
+  test::fill_analytic(backward, sphere, 0.3, 0.04);
+  ASSERT_EQ(backward.block_count(), forward.block_count());
+  ASSERT_NE(backward.hash().block(0), forward.hash().block(0));
+  const TriangleMesh a = extract_mesh(forward), b = extract_mesh(backward);
+  ASSERT_GT(a.vertices.size(), 1000u);
+  EXPECT_EQ(a.vertices, b.vertices);
+  EXPECT_EQ(a.triangles, b.triangles);
+}
+
 TEST(MarchingCubes, UnobservedVoxelsEmitNothing) {
   TsdfVolume volume;
   EXPECT_TRUE(extract_mesh(volume).triangles.empty());
