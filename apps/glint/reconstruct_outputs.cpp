@@ -59,17 +59,15 @@ void write_material_mesh(const std::string& path,
                                        pipeline.albedo_smoothing());
     for (std::size_t i = begin; i < end; ++i) {
       reflectance::PointMaterial material;
-      if (!lookup(mesh.vertices[i], material)) {
-        values[7][i] = float(material.segment);
-        continue;
-      }
+      const bool with_material = lookup(mesh.vertices[i], material);
+      values[7][i] = float(material.segment);
+      if (!with_material) continue;
       mesh.colours[i] = material.refined.kd;
       for (int c = 0; c < 3; ++c) {
         values[c][i] = material.refined.kd[c];
         values[3 + c][i] = material.fused.ks[c];
       }
       values[6][i] = material.fused.alpha;
-      values[7][i] = float(material.segment);
     }
   });
   const std::array<const char*, 8> names{"kd_r", "kd_g", "kd_b",  "ks_r",

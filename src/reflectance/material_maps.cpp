@@ -213,11 +213,6 @@ bool MaterialLookup::operator()(const Eigen::Vector3f& p, PointMaterial& materia
   return true;
 }
 
-bool material_at(const ObservationGrid& grid, const SpecularEstimator& materials,
-                 const Eigen::Vector3f& p, PointMaterial& material, float albedo_smoothing) {
-  return MaterialLookup(grid, materials, albedo_smoothing)(p, material);
-}
-
 namespace {
 
 void put(ImageF& image, int x, int y, const Eigen::Vector3f& value) {

@@ -53,19 +53,6 @@ bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& 
                             Eigen::Vector3f& kd, bool unreliable_corners = true,
                             float smoothing = 0);
 
-// The material at surface point p: the segment of the voxel holding p (else of the nearest
-// labelled neighbour voxel), its fused Ward parameters, and the same with the refined kd (the
-// segment's fused refined kd where interpolate_refined_kd finds no reliable voxel; before the
-// segment has one, the unreliable voxels around p, else the network's kd), smoothed as
-// interpolate_refined_kd() with `albedo_smoothing`. False when p lies in no segment with a
-// material yet.
-struct PointMaterial {
-  int segment = 0;
-  render::WardMaterial fused, refined;
-};
-bool material_at(const ObservationGrid& grid, const SpecularEstimator& materials,
-                 const Eigen::Vector3f& p, PointMaterial& material, float albedo_smoothing = 0);
-
 // The refined albedos of one segment's voxels in the 4^3 around a trilinear cell (from the
 // cell's first corner - 1, x fastest): pool indices, -1 where no voxel of the segment has one.
 struct RefinedNeighbourhood {
@@ -74,7 +61,17 @@ struct RefinedNeighbourhood {
   std::array<int, 64> voxels{};
 };
 
-// material_at() for many points of one model, such as a re-rendering's pixels or a mesh's
+struct PointMaterial {
+  int segment = 0;
+  render::WardMaterial fused, refined;
+};
+
+// The material at surface point p: the segment of the voxel holding p (else of the nearest
+// labelled neighbour voxel), its fused Ward parameters, and the same with the refined kd (the
+// segment's fused refined kd where interpolate_refined_kd finds no reliable voxel; before the
+// segment has one, the unreliable voxels around p, else the network's kd), smoothed as
+// interpolate_refined_kd() with `albedo_smoothing`; false when p lies in no segment with a
+// material yet. Meant for many points of one model, such as a re-rendering's pixels or a mesh's
 // vertices, in an order where neighbours follow each other: it keeps the last point's
 // refined-albedo neighbourhood (64 voxels and a hash look-up per block they touch), which the
 // next point mostly shares. One per thread; the grid must not change while it is in use.

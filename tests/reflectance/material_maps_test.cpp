@@ -178,7 +178,7 @@ TEST(MaterialMaps, SmoothingAveragesTheScatterOfUniformAlbedosButKeepsATextureEd
   EXPECT_GT(kd.x(), 0.35f);
 }
 
-TEST(MaterialMaps, SegmentsRefinedAlbedoStandsWithoutVoxelsAndALookupAgreesWithMaterialAt) {
+TEST(MaterialMaps, SegmentsRefinedAlbedoStandsWithoutVoxelsAndAKeptLookupAgreesWithAFreshOne) {
   Wall wall;
   ObservationGrid& grid = wall.grid();
   SegmentMap segments;
@@ -206,18 +206,18 @@ TEST(MaterialMaps, SegmentsRefinedAlbedoStandsWithoutVoxelsAndALookupAgreesWithM
   // No voxel has a refined albedo: the segment's, beside the network's unrefined one.
   const Eigen::Vector3f p(0.013f, -0.007f, 1.005f);
   PointMaterial material;
-  ASSERT_TRUE(material_at(grid, estimator, p, material));
+  ASSERT_TRUE(MaterialLookup(grid, estimator)(p, material));
   EXPECT_EQ(material.segment, 3);
   EXPECT_TRUE(material.refined.kd.isApprox(segment_kd, 1e-6f));
   EXPECT_TRUE(material.fused.kd.isApprox(estimator.material(3)->ward.kd));
   // Voxels around p with one: theirs.
   wall.with_albedo([](const Eigen::Vector3f&) { return Eigen::Vector3f::Constant(0.7f); });
-  ASSERT_TRUE(material_at(grid, estimator, p, material));
+  ASSERT_TRUE(MaterialLookup(grid, estimator)(p, material));
   EXPECT_TRUE(material.refined.kd.isApprox(Eigen::Vector3f::Constant(0.7f), 1e-6f));
   // Only unreliable ones (grazing light) anywhere: the segment's again.
   wall.with_albedo([](const Eigen::Vector3f&) { return Eigen::Vector3f::Constant(0.95f); },
                    [](const Eigen::Vector3f&) { return false; });
-  ASSERT_TRUE(material_at(grid, estimator, p, material));
+  ASSERT_TRUE(MaterialLookup(grid, estimator)(p, material));
   EXPECT_TRUE(material.refined.kd.isApprox(segment_kd, 1e-6f));
 
   // A lookup that keeps the last point's neighbourhood gives what a fresh one gives, point by
@@ -234,7 +234,7 @@ TEST(MaterialMaps, SegmentsRefinedAlbedoStandsWithoutVoxelsAndALookupAgreesWithM
     const Eigen::Vector3f q(x, 0.011f - 0.3f * x, 1.005f);
     PointMaterial kept, fresh;
     const bool with_material = lookup(q, kept);
-    ASSERT_EQ(with_material, material_at(grid, estimator, q, fresh, 0.2f)) << x;
+    ASSERT_EQ(with_material, MaterialLookup(grid, estimator, 0.2f)(q, fresh)) << x;
     EXPECT_EQ(kept.segment, fresh.segment) << x;
     if (!with_material) {
       ++missing;
