@@ -49,6 +49,7 @@ class Observation {
   }
 
  private:
+  friend struct ObservationLanes;  // the vectorised similarities (observation.cpp)
   static constexpr std::int16_t kUnit = 32767;
   std::array<std::uint16_t, 3> colour_{};  // binary16 bits
   std::array<std::int16_t, 3> direction_{0, 0, kUnit};

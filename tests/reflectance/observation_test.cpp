@@ -96,7 +96,7 @@ TEST(Observations, FillUpToCapacityThenStayFull) {
 TEST(Observations, KeepsTheSameObservationsAsTheBruteForceDefinition) {
   std::mt19937 random(7);
   std::uniform_real_distribution<float> theta(0.0f, 1.5f), phi(0.0f, 6.283f);
-  for (int capacity : {2, 5, 30}) {
+  for (int capacity : {2, 5, 17, 30, 70}) {  // the vectorised searches work 16 at a time
     Voxel voxel(capacity);
     std::vector<Observation> reference(capacity);
     int reference_count = 0;
