@@ -14,10 +14,12 @@ namespace glint::fusion {
 namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-constexpr int kTilePx = 8;
+constexpr int kTilePx = 4;
 
-// Per 8x8-pixel tile, the camera-depth interval that allocated blocks cover (the union of their
+// Per 4x4-pixel tile, the camera-depth interval that allocated blocks cover (the union of their
 // projected bounding boxes), so rays skip the empty space in front of and behind the model.
+// (8x8 tiles let rays start further in front: office's ray cast took 94 ms per view, 88 with
+// 4x4.)
 // Depths are positive floats kept as their bit patterns, which order like the values.
 class TileDepthRanges {
  public:
@@ -141,8 +143,9 @@ SurfaceView raycast(const TsdfVolume& volume, const Intrinsics& intrinsics,
   const VolumeParams& params = volume.params();
   const float voxel = float(params.voxel_size_m), block = float(params.block_size_m());
   const TileDepthRanges ranges(volume, intrinsics, camera_to_world);
+  const BlockOccupancy occupancy(volume);
   parallel_for(static_cast<std::size_t>(height), [&](std::size_t row) {
-    TsdfSampler sampler(volume);
+    TsdfSampler sampler(volume, &occupancy);
     const int y = static_cast<int>(row);
     for (int x = 0; x < width; ++x) {
       float near, far;

@@ -6,14 +6,19 @@
 #include <array>
 #include <cmath>
 
+#include "fusion/block_occupancy.h"
 #include "fusion/tsdf_volume.h"
 
 namespace glint::fusion {
 
 class TsdfSampler {
  public:
-  explicit TsdfSampler(const TsdfVolume& volume)
-      : volume_(volume), inverse_voxel_(1.0f / float(volume.params().voxel_size_m)) {}
+  // With `occupancy` (of this volume, built after its last allocation), blocks it rules out are
+  // not looked up in the block hash.
+  explicit TsdfSampler(const TsdfVolume& volume, const BlockOccupancy* occupancy = nullptr)
+      : volume_(volume),
+        occupancy_(occupancy),
+        inverse_voxel_(1.0f / float(volume.params().voxel_size_m)) {}
 
   enum class Sample { unallocated, unobserved, observed };
 
@@ -110,12 +115,14 @@ class TsdfSampler {
     if (!(cached_ >> entry & 1) || cached_coordinates_[entry] != block) {
       cached_coordinates_[entry] = block;
       cached_ |= 1u << entry;
-      block_[entry] = volume_.hash().find(block);
+      block_[entry] = occupancy_ && !occupancy_->may_hold(bx, by, bz) ? VoxelBlockHash::kAbsent
+                                                                      : volume_.hash().find(block);
     }
     return block_[entry];
   }
 
   const TsdfVolume& volume_;
+  const BlockOccupancy* occupancy_;
   float inverse_voxel_;
   std::array<Eigen::Vector3i, 8> cached_coordinates_;
   std::array<int, 8> block_;

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <vector>
+
 #include "fusion_test_support.h"
 
 namespace glint::fusion {
@@ -87,6 +89,37 @@ TEST(TsdfSampler, ABlockOfTheSameParityIsLookedUpAfresh) {
   EXPECT_EQ(sampler.voxel(3, 3, 3, sdf), TsdfSampler::Sample::observed);
   EXPECT_EQ(sampler.voxel(19, 3, 3, sdf), TsdfSampler::Sample::unallocated);
   EXPECT_EQ(sampler.voxel(3, 3, 3, sdf), TsdfSampler::Sample::observed);
+}
+
+TEST(BlockOccupancy, HoldsEveryAllocatedBlockAndRulesOutTheRest) {
+  TsdfVolume volume(centimetre_voxels());
+  const BlockOccupancy empty(volume);
+  EXPECT_FALSE(empty.may_hold(0, 0, 0)) << "a volume without blocks holds none";
+  const std::vector<Eigen::Vector3i> allocated = {{-3, 0, 2}, {4, -1, 2}, {0, 5, -6}, {1, 1, 1}};
+  for (const Eigen::Vector3i& b : allocated) ASSERT_GE(volume.allocate(b), 0);
+  const BlockOccupancy occupancy(volume);
+  int held = 0;
+  for (int z = -8; z <= 8; ++z)
+    for (int y = -8; y <= 8; ++y)
+      for (int x = -8; x <= 8; ++x) {
+        const bool is_allocated = volume.hash().find({x, y, z}) >= 0;
+        EXPECT_EQ(occupancy.may_hold(x, y, z), is_allocated) << x << " " << y << " " << z;
+        held += is_allocated;
+      }
+  EXPECT_EQ(held, int(allocated.size()));
+  EXPECT_FALSE(occupancy.may_hold(1 << 19, 0, 0));
+  EXPECT_FALSE(occupancy.may_hold(-(1 << 19), 0, 0));
+
+  // A sampler told of the occupancy reads the same samples as one that asks the hash.
+  const int block = volume.hash().find({1, 1, 1});
+  std::fill_n(volume.sdf_m(block), kVoxelsPerBlock, 0.02f);
+  std::fill_n(volume.weight(block), kVoxelsPerBlock, 1.0f);
+  TsdfSampler plain(volume), told(volume, &occupancy);
+  for (int x = 0; x < 40; ++x) {
+    float a = 0, b = 0;
+    ASSERT_EQ(plain.voxel(x, 12, 12, a), told.voxel(x, 12, 12, b)) << x;
+    EXPECT_EQ(a, b);
+  }
 }
 
 }  // namespace

@@ -1,0 +1,42 @@
+#pragma once
+// BlockOccupancy: which blocks of a TSDF volume are allocated, one bit per block over the
+// bounding box of the allocated ones. A ray cast crosses far more empty blocks than allocated
+// ones (office: 1.65 M samples per view in unallocated space), and asking the block hash about
+// each missed the caches: the hash table is megabytes of slots, the bit array a few hundred
+// kilobytes. A snapshot: blocks allocated afterwards are not in it.
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "fusion/tsdf_volume.h"
+
+namespace glint::fusion {
+
+class BlockOccupancy {
+ public:
+  // Bit arrays above this many bits (a bounding box of 2^30 blocks: 43 km^3 of 4 cm blocks) are
+  // not built; holds() then answers true for every block.
+  static constexpr std::uint64_t kMaxBits = std::uint64_t{1} << 30;
+
+  explicit BlockOccupancy(const TsdfVolume& volume);
+
+  // False only where block (bx, by, bz) is surely not allocated.
+  bool may_hold(int bx, int by, int bz) const {
+    if (words_.empty()) return !built_empty_;
+    const std::uint64_t x = std::uint64_t(std::int64_t(bx) - low_.x());
+    const std::uint64_t y = std::uint64_t(std::int64_t(by) - low_.y());
+    const std::uint64_t z = std::uint64_t(std::int64_t(bz) - low_.z());
+    if (x >= std::uint64_t(size_.x()) || y >= std::uint64_t(size_.y()) ||
+        z >= std::uint64_t(size_.z()))
+      return false;
+    const std::uint64_t bit = (z * std::uint64_t(size_.y()) + y) * std::uint64_t(size_.x()) + x;
+    return words_[bit >> 6] >> (bit & 63) & 1;
+  }
+
+ private:
+  Eigen::Vector3i low_ = Eigen::Vector3i::Zero(), size_ = Eigen::Vector3i::Zero();
+  std::vector<std::uint64_t> words_;
+  bool built_empty_ = false;  // the volume held no block
+};
+
+}  // namespace glint::fusion
