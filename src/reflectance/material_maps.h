@@ -59,6 +59,10 @@ struct RefinedNeighbourhood {
   Eigen::Vector3i base = Eigen::Vector3i::Constant(std::numeric_limits<int>::min());
   int segment = -1;
   std::array<int, 64> voxels{};
+  // Those with a reliable refined albedo, as arrays for the smoothing's vectorised loop: the
+  // albedo and the offset from the cell's first corner.
+  int reliable = 0;
+  std::array<float, 64> red, green, blue, dx, dy, dz;
 };
 
 struct PointMaterial {

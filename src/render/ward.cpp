@@ -1,32 +1,8 @@
 #include "render/ward.h"
 
-#include <bit>
-#include <cstdint>
+#include "core/fast_exp.h"
 
 namespace glint::render {
-namespace {
-
-// exp(x) for x in [-40, 0] without a library call, so that the loop below vectorises: x =
-// n ln 2 + r with |r| <= ln 2 / 2 (ln 2 split in two for an exact product), exp(r) by its
-// degree-7 Taylor polynomial (relative error below 2e-7 there), 2^n by building the exponent.
-inline float exp_nonpositive(float x) {
-  constexpr float kLog2e = 1.44269504f, kLn2High = 0.693145752f, kLn2Low = 1.42860677e-6f;
-  constexpr float kRound = 12582912.0f;  // 1.5 * 2^23: adding it rounds to an integer
-  const float n = (x * kLog2e + kRound) - kRound;
-  const float r = (x - n * kLn2High) - n * kLn2Low;
-  float p = 1.0f / 5040;
-  p = p * r + 1.0f / 720;
-  p = p * r + 1.0f / 120;
-  p = p * r + 1.0f / 24;
-  p = p * r + 1.0f / 6;
-  p = p * r + 0.5f;
-  p = p * r + 1.0f;
-  p = p * r + 1.0f;
-  const float scale = std::bit_cast<float>((static_cast<std::int32_t>(n) + 127) << 23);
-  return p * scale;
-}
-
-}  // namespace
 
 #if defined(__x86_64__)
 __attribute__((target_clones("arch=x86-64-v3", "default")))
