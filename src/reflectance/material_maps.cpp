@@ -10,11 +10,12 @@
 
 namespace glint::reflectance {
 
-Eigen::Vector3f shade_ward(const render::WardMaterial& material, const Eigen::Vector3f& p,
-                           const Eigen::Vector3f& n, const Eigen::Vector3f& eye,
-                           const std::vector<render::PointLight>& lights) {
+WardShading ward_shading(float alpha, const Eigen::Vector3f& p, const Eigen::Vector3f& n,
+                         const Eigen::Vector3f& eye,
+                         const std::vector<render::PointLight>& lights) {
+  WardShading shading{Eigen::Vector3f::Zero(), Eigen::Vector3f::Zero()};
   const Eigen::Vector3f wo = (eye - p).normalized();
-  Eigen::Vector3f radiance = Eigen::Vector3f::Zero();
+  if (!(n.dot(wo) > 0.0f)) return shading;  // seen from behind: no light leaves towards the eye
   for (const render::PointLight& light : lights) {
     const Eigen::Vector3f to_light = light.position.cast<float>() - p;
     const float distance2 = to_light.squaredNorm();
@@ -22,10 +23,11 @@ Eigen::Vector3f shade_ward(const render::WardMaterial& material, const Eigen::Ve
     const Eigen::Vector3f wi = to_light / std::sqrt(distance2);
     const float cos_i = n.dot(wi);
     if (cos_i <= 0) continue;
-    radiance +=
-        render::ward_brdf(material, n, wi, wo).cwiseProduct(light.intensity) * (cos_i / distance2);
+    const Eigen::Vector3f irradiance = light.intensity * (cos_i / distance2);
+    shading.diffuse += irradiance;
+    shading.specular += irradiance * render::ward_specular_lobe(n, wi, wo, alpha);
   }
-  return radiance;
+  return shading;
 }
 
 namespace {
@@ -270,8 +272,10 @@ MaterialMaps render_material_maps(const fusion::SurfaceView& surface, const Pose
       const auto pixel = [&](const Eigen::Vector3f& radiance) {
         return (radiance * exposure).cwiseMax(0.0f).cwiseMin(1.0f).eval();
       };
-      put(maps.rgb, x, y, pixel(shade_ward(material.fused, p, n, eye, lights)));
-      put(maps.rgb_refined, x, y, pixel(shade_ward(material.refined, p, n, eye, lights)));
+      // The two materials differ in kd only: one shading serves both.
+      const WardShading shading = ward_shading(material.fused.alpha, p, n, eye, lights);
+      put(maps.rgb, x, y, pixel(shading.radiance(material.fused)));
+      put(maps.rgb_refined, x, y, pixel(shading.radiance(material.refined)));
     }
   });
   return maps;

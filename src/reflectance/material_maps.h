@@ -8,6 +8,7 @@
 // no shadows, as the albedo refinement assumes), once with the HemiCNN's kd and once with the
 // refined kd.
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -29,11 +30,18 @@ struct MaterialMaps {
   ImageF covered;               // 1 where the model was hit and its segment has a material
 };
 
-// Outgoing radiance at surface point p with unit normal n seen from `eye`, eq. (6) summed over
-// the point lights (L_l = intensity / r^2).
-Eigen::Vector3f shade_ward(const render::WardMaterial& material, const Eigen::Vector3f& p,
-                           const Eigen::Vector3f& n, const Eigen::Vector3f& eye,
-                           const std::vector<render::PointLight>& lights);
+// Eq. (6) summed over the point lights (L_l = intensity / r^2) with the material factored out:
+// the outgoing radiance at a point is kd / pi * diffuse + ks * specular (per channel), where
+// diffuse = sum_l L_l cos(theta_i,l) and specular weighs each term by the Ward lobe of the
+// roughness alpha. Both are 0 where the eye sees the surface from behind.
+struct WardShading {
+  Eigen::Vector3f diffuse, specular;
+  Eigen::Vector3f radiance(const render::WardMaterial& material) const {
+    return (material.kd / float(M_PI)).cwiseProduct(diffuse) + material.ks.cwiseProduct(specular);
+  }
+};
+WardShading ward_shading(float alpha, const Eigen::Vector3f& p, const Eigen::Vector3f& n,
+                         const Eigen::Vector3f& eye, const std::vector<render::PointLight>& lights);
 
 // Refined kd at p: trilinear weights of the 8 observation voxels around p, restricted to those
 // of `segment` with a refined albedo, and of those to the reliable ones (solved under light

@@ -27,7 +27,9 @@ TEST(MaterialMaps, ShadingIsEquationSixSummedOverTheLights) {
   lights[1].intensity = {9, 9, 9};
   const Eigen::Vector3f wi(0, 0, 1), wo = (eye - p).normalized();
   const Eigen::Vector3f expected = render::ward_brdf(m, n, wi, wo) * 4.0f / 4.0f;  // I/r^2 cos
-  EXPECT_TRUE(shade_ward(m, p, n, eye, lights).isApprox(expected, 1e-6f));
+  EXPECT_TRUE(ward_shading(m.alpha, p, n, eye, lights).radiance(m).isApprox(expected, 1e-6f));
+  // Seen from behind, nothing.
+  EXPECT_TRUE(ward_shading(m.alpha, p, n, Eigen::Vector3f(1, 0, -2), lights).radiance(m).isZero());
 }
 
 // Observation voxels (2 cm) of a wall at z = 1.005 m, inside one layer of them (not on a voxel
