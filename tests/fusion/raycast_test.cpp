@@ -64,6 +64,22 @@ TEST(Raycast, SphereDepthAndNormalsMatchTheAnalyticSurface) {
   EXPECT_EQ(view.depth_m.at(0, 0, 0), 0.0f);  // the corner ray misses
 }
 
+TEST(Raycast, RaysCrossMetresOfEmptySpaceToAFarWall) {
+  // A wall 3 m away, and one block of free space 0.24-0.32 m in front of the camera: it projects
+  // over most of the image, so those rays start there and cross 2.7 m of empty blocks, which
+  // they leave region by region (BlockOccupancy).
+  constexpr double kWall = 3.0;
+  const auto volume = analytic_volume([](const Eigen::Vector3d& p) { return kWall - p.z(); }, 3.2);
+  const int near_block = volume->allocate({0, 0, 3});
+  ASSERT_GE(near_block, 0);
+  std::fill_n(volume->sdf_m(near_block), kVoxelsPerBlock, 0.04f);
+  std::fill_n(volume->weight(near_block), kVoxelsPerBlock, 1.0f);
+  const SurfaceView view = raycast(*volume, kCamera, Pose::Identity());
+  for (int y = 0; y < kCamera.height; ++y)
+    for (int x = 0; x < kCamera.width; ++x)
+      ASSERT_NEAR(view.depth_m.at(x, y, 0), kWall, 0.002) << x << "," << y;
+}
+
 TEST(Raycast, GradientNormalsHoldAtSilhouettes) {
   // The sphere in front of a wall: at its silhouette the neighbouring pixels lie on the wall, so
   // the points' cross product is no normal of either; the TSDF's gradient is the sphere's own.
