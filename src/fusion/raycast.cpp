@@ -47,18 +47,28 @@ class TileDepthRanges {
         z_max = std::max(z_max, corners[c].z());
       }
       if (z_max < params.depth_min_m || z_min > params.depth_max_m) return;
-      int x0 = 0, y0 = 0, x1 = tiles_x_ - 1, y1 = tiles_y - 1;
-      if (z_min > params.depth_min_m) {  // wholly in front of the camera: its projected box
-        for (const Eigen::Vector3d& corner : corners) {
-          const Eigen::Vector2d uv = k.project(corner);
-          low = low.cwiseMin(uv);
-          high = high.cwiseMax(uv);
+      // The projected bounding box of the block's part beyond the near plane z = depth_min (rays
+      // start there): its corners beyond it and where its edges cross it. (Counting a block that
+      // straddles the plane as covering every tile made every ray of the frame start at the
+      // near plane: bunnies, 90-150 such blocks in a third of the views.)
+      const auto cover = [&](const Eigen::Vector3d& point) {
+        const Eigen::Vector2d uv = k.project(point);
+        low = low.cwiseMin(uv);
+        high = high.cwiseMax(uv);
+      };
+      for (int c = 0; c < 8; ++c) {
+        if (corners[c].z() >= params.depth_min_m) cover(corners[c]);
+        for (int axis = 1; axis < 8; axis <<= 1) {
+          if (c & axis) continue;
+          const Eigen::Vector3d &a = corners[c], &b = corners[c | axis];
+          if ((a.z() < params.depth_min_m) != (b.z() < params.depth_min_m))
+            cover(a + (b - a) * ((params.depth_min_m - a.z()) / (b.z() - a.z())));
         }
-        x0 = std::max(0, int(std::floor((low.x() + 0.5) / kTilePx)));
-        y0 = std::max(0, int(std::floor((low.y() + 0.5) / kTilePx)));
-        x1 = std::min(tiles_x_ - 1, int(std::floor((high.x() + 0.5) / kTilePx)));
-        y1 = std::min(tiles_y - 1, int(std::floor((high.y() + 0.5) / kTilePx)));
       }
+      const int x0 = std::max(0, int(std::floor((low.x() + 0.5) / kTilePx)));
+      const int y0 = std::max(0, int(std::floor((low.y() + 0.5) / kTilePx)));
+      const int x1 = std::min(tiles_x_ - 1, int(std::floor((high.x() + 0.5) / kTilePx)));
+      const int y1 = std::min(tiles_y - 1, int(std::floor((high.y() + 0.5) / kTilePx)));
       const auto near = std::bit_cast<std::uint32_t>(float(std::max(z_min, params.depth_min_m)));
       const auto far = std::bit_cast<std::uint32_t>(float(z_max));
       for (int ty = y0; ty <= y1; ++ty)

@@ -65,15 +65,19 @@ TEST(Raycast, SphereDepthAndNormalsMatchTheAnalyticSurface) {
 }
 
 TEST(Raycast, RaysCrossMetresOfEmptySpaceToAFarWall) {
-  // A wall 3 m away, and one block of free space 0.24-0.32 m in front of the camera: it projects
+  // A wall 3 m away, and a block of free space 0.24-0.32 m in front of the camera: it projects
   // over most of the image, so those rays start there and cross 2.7 m of empty blocks, which
   // they leave region by region (BlockOccupancy).
   constexpr double kWall = 3.0;
   const auto volume = analytic_volume([](const Eigen::Vector3d& p) { return kWall - p.z(); }, 3.2);
-  const int near_block = volume->allocate({0, 0, 3});
-  ASSERT_GE(near_block, 0);
-  std::fill_n(volume->sdf_m(near_block), kVoxelsPerBlock, 0.04f);
-  std::fill_n(volume->weight(near_block), kVoxelsPerBlock, 1.0f);
+  // And one across the near plane (z = 0.1 m) beside the camera: only its part beyond the plane
+  // counts for the tiles' depth ranges.
+  for (const Eigen::Vector3i& b : {Eigen::Vector3i(0, 0, 3), Eigen::Vector3i(3, 0, 1)}) {
+    const int near_block = volume->allocate(b);
+    ASSERT_GE(near_block, 0);
+    std::fill_n(volume->sdf_m(near_block), kVoxelsPerBlock, 0.04f);
+    std::fill_n(volume->weight(near_block), kVoxelsPerBlock, 1.0f);
+  }
   const SurfaceView view = raycast(*volume, kCamera, Pose::Identity());
   for (int y = 0; y < kCamera.height; ++y)
     for (int x = 0; x < kCamera.width; ++x)
