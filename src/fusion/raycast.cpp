@@ -96,36 +96,11 @@ class TileDepthRanges {
   std::vector<std::atomic<std::uint32_t>> near_, far_;
 };
 
-// Where the ray origin + t * ray leaves the empty region of blocks around the unallocated block
-// of the voxel nearest to p (BlockOccupancy::empty_side): the nearest-voxel samples in between
-// would all read unallocated blocks. 0 where only that block is known to be empty (stepping
-// half a block on costs less than finding its exit). A block b holds the voxels nearest to
-// points in [(8 b - 0.5) voxel, (8 b + 7.5) voxel) along each axis. inverse_ray: 1 / ray per
-// axis (infinite along an axis the ray does not move on).
-float exit_from_empty_space(const BlockOccupancy& occupancy, const Eigen::Vector3f& origin,
-                            const Eigen::Vector3f& inverse_ray, const Eigen::Vector3f& p,
-                            float inverse_voxel, float voxel) {
-  Eigen::Vector3i b;
-  for (int axis = 0; axis < 3; ++axis)  // as TsdfSampler::nearest()
-    b[axis] = int(std::floor(p[axis] * inverse_voxel + 0.5f)) >> 3;
-  const int side = occupancy.empty_side(b.x(), b.y(), b.z());
-  if (side == 1) return 0;
-  float exit = INFINITY;
-  for (int axis = 0; axis < 3; ++axis) {
-    const int first = BlockOccupancy::region(b[axis], side) * side;
-    const int face = kBlockSide * (inverse_ray[axis] > 0 ? first + side : first);
-    const float t = ((float(face) - 0.5f) * voxel - origin[axis]) * inverse_ray[axis];
-    if (std::isfinite(t)) exit = std::min(exit, t);
-  }
-  return exit;
-}
-
 // Depth t (metres along the optical axis) of the first + to - crossing along origin + t * ray,
 // or 0 when there is none in [t_min, t_max]. ray has z = 1 in camera space.
-float march(TsdfSampler& sampler, const BlockOccupancy& occupancy, const Eigen::Vector3f& origin,
-            const Eigen::Vector3f& ray, float t_min, float t_max, float voxel, float block) {
-  const float inverse_length = 1.0f / ray.norm(), inverse_voxel = 1.0f / voxel;
-  const Eigen::Vector3f inverse_ray = ray.cwiseInverse();
+float march(TsdfSampler& sampler, const Eigen::Vector3f& origin, const Eigen::Vector3f& ray,
+            float t_min, float t_max, float voxel, float block) {
+  const float inverse_length = 1.0f / ray.norm();
   float previous_t = 0, previous_sdf = 0;
   bool previous_observed = false;
   for (float t = t_min; t <= t_max;) {
@@ -138,16 +113,7 @@ float march(TsdfSampler& sampler, const BlockOccupancy& occupancy, const Eigen::
       sample = TsdfSampler::Sample::unobserved;
     if (sample != TsdfSampler::Sample::observed) {
       previous_observed = false;
-      // Past an empty region at once (a hundredth of a voxel beyond, against rounding), else
-      // half a block on through an unallocated block, or a voxel through allocated but
-      // unobserved space.
-      if (sample == TsdfSampler::Sample::unallocated) {
-        const float exit =
-            exit_from_empty_space(occupancy, origin, inverse_ray, p, inverse_voxel, voxel);
-        t = exit > t ? exit + 0.01f * voxel * inverse_length : t + 0.5f * block * inverse_length;
-      } else {
-        t += voxel * inverse_length;
-      }
+      t += (sample == TsdfSampler::Sample::unallocated ? 0.5f * block : voxel) * inverse_length;
       continue;
     }
     if (sdf < 0) {
@@ -196,7 +162,7 @@ SurfaceView raycast(const TsdfVolume& volume, const Intrinsics& intrinsics,
       ranges.interval(x, y, near, far);
       if (near > far) continue;
       const Eigen::Vector3f ray = rotation * intrinsics.ray(x, y).cast<float>();
-      const float t = march(sampler, occupancy, origin, ray, near, far, voxel, block);
+      const float t = march(sampler, origin, ray, near, far, voxel, block);
       if (t <= 0) continue;
       const Eigen::Vector3f p = origin + ray * t;
       view.depth_m.at(x, y, 0) = t;

@@ -66,8 +66,7 @@ TEST(Raycast, SphereDepthAndNormalsMatchTheAnalyticSurface) {
 
 TEST(Raycast, RaysCrossMetresOfEmptySpaceToAFarWall) {
   // A wall 3 m away, and a block of free space 0.24-0.32 m in front of the camera: it projects
-  // over most of the image, so those rays start there and cross 2.7 m of empty blocks, which
-  // they leave region by region (BlockOccupancy).
+  // over a third of the image, so those rays start there and cross 2.7 m of empty blocks.
   constexpr double kWall = 3.0;
   const auto volume = analytic_volume([](const Eigen::Vector3d& p) { return kWall - p.z(); }, 3.2);
   // And one across the near plane (z = 0.1 m) beside the camera: only its part beyond the plane

@@ -91,7 +91,7 @@ TEST(TsdfSampler, ABlockOfTheSameParityIsLookedUpAfresh) {
   EXPECT_EQ(sampler.voxel(3, 3, 3, sdf), TsdfSampler::Sample::observed);
 }
 
-TEST(BlockOccupancy, HoldsEveryAllocatedBlockAndFindsTheEmptyRegionsAround) {
+TEST(BlockOccupancy, HoldsEveryAllocatedBlockAndRulesOutTheRest) {
   TsdfVolume volume(centimetre_voxels());
   const BlockOccupancy empty(volume);
   EXPECT_FALSE(empty.may_hold(0, 0, 0)) << "a volume without blocks holds none";
@@ -109,21 +109,6 @@ TEST(BlockOccupancy, HoldsEveryAllocatedBlockAndFindsTheEmptyRegionsAround) {
   EXPECT_EQ(held, int(allocated.size()));
   EXPECT_FALSE(occupancy.may_hold(1 << 19, 0, 0));
   EXPECT_FALSE(occupancy.may_hold(-(1 << 19), 0, 0));
-
-  // Empty cubes around unallocated blocks: the 4^3 regions of (2, 2, 2) and (-4, 0, 2) hold
-  // (1, 1, 1) and (-3, 0, 2); those of (-5, 0, 2) and (-8, 0, 2) are empty but their 16^3 region
-  // holds (-3, 0, 2); the 16^3 regions of (16, 0, 0), (-17, 0, 0) and (-8, -4, 4) hold none.
-  EXPECT_EQ(occupancy.empty_side(2, 2, 2), 1);
-  EXPECT_EQ(occupancy.empty_side(-4, 0, 2), 1) << "its 4^3 region holds (-3, 0, 2)";
-  EXPECT_EQ(occupancy.empty_side(-5, 0, 2), BlockOccupancy::kSmallRegion);
-  EXPECT_EQ(occupancy.empty_side(-8, 0, 2), BlockOccupancy::kSmallRegion);
-  EXPECT_EQ(occupancy.empty_side(-8, -4, 4), BlockOccupancy::kLargeRegion);
-  EXPECT_EQ(occupancy.empty_side(16, 0, 0), BlockOccupancy::kLargeRegion);
-  EXPECT_EQ(occupancy.empty_side(-17, 0, 0), BlockOccupancy::kLargeRegion);
-  EXPECT_EQ(BlockOccupancy::region(-1, 4), -1);
-  EXPECT_EQ(BlockOccupancy::region(-4, 4), -1);
-  EXPECT_EQ(BlockOccupancy::region(-5, 4), -2);
-  EXPECT_EQ(BlockOccupancy::region(15, 16), 0);
 
   // A sampler told of the occupancy reads the same samples as one that asks the hash.
   const int block = volume.hash().find({1, 1, 1});
