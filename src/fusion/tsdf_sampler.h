@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 
+#include "fusion/block_index_cache.h"
 #include "fusion/block_occupancy.h"
 #include "fusion/tsdf_volume.h"
 
@@ -107,26 +108,19 @@ class TsdfSampler {
   static int round_to_int(float value) { return static_cast<int>(std::floor(value + 0.5f)); }
 
   // The pool index of block (bx, by, bz), or -1. A stencil of a few voxels spans at most two
-  // blocks along each axis, which differ in the parity of that coordinate: one cache entry per
-  // parity triple holds all eight, where a single entry was looked up again at every crossing.
+  // blocks along each axis: a cache of two per axis holds all eight, where a single entry was
+  // looked up again at every crossing.
   int cached_block(int bx, int by, int bz) {
-    const int entry = (bx & 1) | ((by & 1) << 1) | ((bz & 1) << 2);
-    const Eigen::Vector3i block(bx, by, bz);
-    if (!(cached_ >> entry & 1) || cached_coordinates_[entry] != block) {
-      cached_coordinates_[entry] = block;
-      cached_ |= 1u << entry;
-      block_[entry] = occupancy_ && !occupancy_->may_hold(bx, by, bz) ? VoxelBlockHash::kAbsent
-                                                                      : volume_.hash().find(block);
-    }
-    return block_[entry];
+    return blocks_({bx, by, bz}, [&](const Eigen::Vector3i& block) {
+      return occupancy_ && !occupancy_->may_hold(bx, by, bz) ? VoxelBlockHash::kAbsent
+                                                             : volume_.hash().find(block);
+    });
   }
 
   const TsdfVolume& volume_;
   const BlockOccupancy* occupancy_;
   float inverse_voxel_;
-  std::array<Eigen::Vector3i, 8> cached_coordinates_;
-  std::array<int, 8> block_;
-  unsigned cached_ = 0;  // bit e: entry e holds a block
+  BlockIndexCache<2> blocks_;
 };
 
 }  // namespace glint::fusion

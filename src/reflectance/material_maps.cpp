@@ -92,11 +92,11 @@ Cell cell_of(const ObservationGrid& grid, const Eigen::Vector3f& p) {
 
 // Fills `around` for the cell at `base` and `segment`, unless it holds them already.
 void look_up(const ObservationGrid& grid, const Eigen::Vector3i& base, int segment,
-             RefinedNeighbourhood& around) {
+             RefinedNeighbourhood& around, ObservationGrid::BlockCache* cache = nullptr) {
   if (around.segment == segment && around.base == base) return;
   around.base = base;
   around.segment = segment;
-  grid.find_voxels(base - Eigen::Vector3i::Ones(), 4, around.voxels.data());
+  grid.find_voxels(base - Eigen::Vector3i::Ones(), 4, around.voxels.data(), cache);
   around.reliable = 0;
   for (int i = 0; i < 64; ++i) {
     int& v = around.voxels[std::size_t(i)];
@@ -198,8 +198,9 @@ bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& 
 namespace {
 
 // Segment of the voxel holding p, else of the nearest labelled of its 26 neighbours.
-int segment_at(const ObservationGrid& grid, const Eigen::Vector3f& p) {
-  const int v = grid.find(p);
+int segment_at(const ObservationGrid& grid, const Eigen::Vector3f& p,
+               ObservationGrid::BlockCache& cache) {
+  const int v = grid.find(p, &cache);
   if (v >= 0 && grid.segment(v) > 0) return grid.segment(v);
   const float size = float(grid.params().voxel_size_m);
   const Eigen::Vector3f g = p / size;
@@ -211,7 +212,7 @@ int segment_at(const ObservationGrid& grid, const Eigen::Vector3f& p) {
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
         const Eigen::Vector3i voxel = centre + Eigen::Vector3i(dx, dy, dz);
-        const int n = grid.find_voxel(voxel);
+        const int n = grid.find_voxel(voxel, &cache);
         if (n < 0 || grid.segment(n) <= 0) continue;
         const float distance = (grid.voxel_centre(voxel) - p).squaredNorm();
         if (distance < best_distance) best = grid.segment(n), best_distance = distance;
@@ -222,13 +223,13 @@ int segment_at(const ObservationGrid& grid, const Eigen::Vector3f& p) {
 }  // namespace
 
 bool MaterialLookup::operator()(const Eigen::Vector3f& p, PointMaterial& material) {
-  material.segment = segment_at(grid_, p);
+  material.segment = segment_at(grid_, p, blocks_);
   const SegmentMaterial* fused = materials_.material(material.segment);
   if (!fused) return false;
   material.fused = material.refined = fused->ward;
   if (fused->kd_refined) material.refined.kd = *fused->kd_refined;
   const Cell cell = cell_of(grid_, p);
-  look_up(grid_, cell.base, material.segment, around_);
+  look_up(grid_, cell.base, material.segment, around_, &blocks_);
   interpolate(grid_, around_, cell.t, material.refined.kd, !fused->kd_refined, albedo_smoothing_);
   return true;
 }

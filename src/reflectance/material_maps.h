@@ -85,8 +85,9 @@ struct PointMaterial {
 // interpolate_refined_kd() with `albedo_smoothing`; false when p lies in no segment with a
 // material yet. Meant for many points of one model, such as a re-rendering's pixels or a mesh's
 // vertices, in an order where neighbours follow each other: it keeps the last point's
-// refined-albedo neighbourhood (64 voxels and a hash look-up per block they touch), which the
-// next point mostly shares. One per thread; the grid must not change while it is in use.
+// refined-albedo neighbourhood (64 voxels), which the next point mostly shares, and the grid
+// blocks it found last (ObservationGrid::BlockCache). One per thread; the grid must not change
+// while it is in use.
 class MaterialLookup {
  public:
   MaterialLookup(const ObservationGrid& grid, const SpecularEstimator& materials,
@@ -99,6 +100,7 @@ class MaterialLookup {
   const SpecularEstimator& materials_;
   float albedo_smoothing_;
   RefinedNeighbourhood around_;
+  ObservationGrid::BlockCache blocks_;  // the grid blocks found last
 };
 
 MaterialMaps render_material_maps(const fusion::SurfaceView& surface, const Pose& camera_to_world,

@@ -171,21 +171,22 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
   for (std::size_t i = 0; i < hash_.capacity(); ++i) block_last_frame_[i] = -1;
 }
 
-int ObservationGrid::find_voxel(const Eigen::Vector3i& voxel) const {
+int ObservationGrid::find_voxel(const Eigen::Vector3i& voxel, BlockCache* cache) const {
   const Eigen::Vector3i block = floor_div(voxel, side_);
-  const int index = hash_.find(block);
+  const int index = find_block(block, cache);
   if (index < 0) return -1;
   return voxel_index(index, voxel - block * side_);
 }
 
-void ObservationGrid::find_voxels(const Eigen::Vector3i& first, int n, int* voxels) const {
+void ObservationGrid::find_voxels(const Eigen::Vector3i& first, int n, int* voxels,
+                                  BlockCache* cache) const {
   std::fill_n(voxels, n * n * n, -1);
   const Eigen::Vector3i last = first + Eigen::Vector3i::Constant(n - 1);
   const Eigen::Vector3i first_block = floor_div(first, side_), last_block = floor_div(last, side_);
   for (int bz = first_block.z(); bz <= last_block.z(); ++bz)
     for (int by = first_block.y(); by <= last_block.y(); ++by)
       for (int bx = first_block.x(); bx <= last_block.x(); ++bx) {
-        const int index = hash_.find({bx, by, bz});
+        const int index = find_block({bx, by, bz}, cache);
         if (index < 0) continue;
         const Eigen::Vector3i origin = Eigen::Vector3i(bx, by, bz) * side_;
         // The block's voxels within the range.
@@ -199,9 +200,10 @@ void ObservationGrid::find_voxels(const Eigen::Vector3i& first, int n, int* voxe
       }
 }
 
-int ObservationGrid::find(const Eigen::Vector3f& p) const {
+int ObservationGrid::find(const Eigen::Vector3f& p, BlockCache* cache) const {
   const Eigen::Vector3f v = p / float(params_.voxel_size_m);
-  return find_voxel({int(std::floor(v.x())), int(std::floor(v.y())), int(std::floor(v.z()))});
+  return find_voxel({int(std::floor(v.x())), int(std::floor(v.y())), int(std::floor(v.z()))},
+                    cache);
 }
 
 Eigen::Vector3i ObservationGrid::voxel_coordinates(int v) const {

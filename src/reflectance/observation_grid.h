@@ -32,6 +32,7 @@
 #include "core/camera.h"
 #include "core/image.h"
 #include "core/pool_memory.h"
+#include "fusion/block_index_cache.h"
 #include "fusion/tsdf_sampler.h"
 #include "fusion/tsdf_volume.h"
 #include "fusion/voxel_block_hash.h"
@@ -142,13 +143,17 @@ class ObservationGrid {
   bool& refined_kd_reliable(int v) { return refined_kd_reliable_[v]; }
   bool refined_kd_reliable(int v) const { return refined_kd_reliable_[v]; }
 
+  // Look-ups of many nearby voxels (a rendering's pixels, a mesh's vertices) may keep the
+  // blocks they found in a cache of their own (one per thread), which spares most hash look-ups.
+  using BlockCache = fusion::BlockIndexCache<4>;
   // Pool index of the voxel containing world point p, or -1.
-  int find(const Eigen::Vector3f& p) const;
+  int find(const Eigen::Vector3f& p, BlockCache* cache = nullptr) const;
   // Pool index of the voxel at integer grid coordinates, or -1.
-  int find_voxel(const Eigen::Vector3i& voxel) const;
+  int find_voxel(const Eigen::Vector3i& voxel, BlockCache* cache = nullptr) const;
   // find_voxel() of the n^3 voxels from grid coordinates `first` on (x fastest, then y, z) into
-  // voxels[0, n^3), with one hash look-up per block they touch.
-  void find_voxels(const Eigen::Vector3i& first, int n, int* voxels) const;
+  // voxels[0, n^3), with one block look-up per block they touch.
+  void find_voxels(const Eigen::Vector3i& first, int n, int* voxels,
+                   BlockCache* cache = nullptr) const;
   // Integer grid coordinates of pool index v.
   Eigen::Vector3i voxel_coordinates(int v) const;
   // World centre of the voxel at integer grid coordinates.
@@ -157,6 +162,12 @@ class ObservationGrid {
   }
 
  private:
+  // The pool index of a block of this grid, through `cache` when there is one.
+  int find_block(const Eigen::Vector3i& block, BlockCache* cache) const {
+    if (!cache) return hash_.find(block);
+    return (*cache)(block, [&](const Eigen::Vector3i& b) { return hash_.find(b); });
+  }
+
   // The first of voxel v's observation slots (0 while it has none: nothing reads them then).
   std::size_t first_slot(int v) const {
     return observation_set_[v] == 0
