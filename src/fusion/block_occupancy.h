@@ -15,7 +15,7 @@ namespace glint::fusion {
 class BlockOccupancy {
  public:
   // Bit arrays above this many bits (a bounding box of 2^30 blocks: 43 km^3 of 4 cm blocks) are
-  // not built; holds() then answers true for every block.
+  // not built; may_hold() then answers true for every block.
   static constexpr std::uint64_t kMaxBits = std::uint64_t{1} << 30;
 
   explicit BlockOccupancy(const TsdfVolume& volume);

@@ -112,8 +112,9 @@ class TsdfSampler {
   // looked up again at every crossing.
   int cached_block(int bx, int by, int bz) {
     return blocks_({bx, by, bz}, [&](const Eigen::Vector3i& block) {
-      return occupancy_ && !occupancy_->may_hold(bx, by, bz) ? VoxelBlockHash::kAbsent
-                                                             : volume_.hash().find(block);
+      return occupancy_ && !occupancy_->may_hold(block.x(), block.y(), block.z())
+                 ? VoxelBlockHash::kAbsent
+                 : volume_.hash().find(block);
     });
   }
 

@@ -141,16 +141,13 @@ void smooth_refined_kd(const RefinedNeighbourhood& around, const Eigen::Vector3f
   // exp_nonpositive()'s range (a contrast that small weighs every other albedo at e^-50 or less
   // anyway).
   const float inverse_scale = std::min(1.0f / (contrast * (kd.mean() + 0.01f)) / 3.0f, 1000.0f);
-  const float tx = t.x(), ty = t.y(), tz = t.z();
   std::array<float, 64> weight;
   for (int k = 0; k < around.reliable; ++k) {
     const float r = (std::fabs(around.red[k] - red) + std::fabs(around.green[k] - green) +
                      std::fabs(around.blue[k] - blue)) *
                     inverse_scale;
-    const float tent = (1 - 0.5f * std::fabs(tx - around.dx[k])) *
-                       (1 - 0.5f * std::fabs(ty - around.dy[k])) *
-                       (1 - 0.5f * std::fabs(tz - around.dz[k]));
-    weight[k] = tent * exp_nonpositive(-0.5f * r * r);
+    weight[k] =
+        wide_tent(t, around.dx[k], around.dy[k], around.dz[k]) * exp_nonpositive(-0.5f * r * r);
   }
   Eigen::Vector3f sum = Eigen::Vector3f::Zero();
   float weights = 0;
