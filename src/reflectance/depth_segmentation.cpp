@@ -58,6 +58,10 @@ template <class T, bool kCheckBounds = false>
   using Mask = decltype(T{} > T{});
   const T vx = load<T>(m.vx + i), vy = load<T>(m.vy + i), z = load<T>(m.vz + i);
   const T nx = load<T>(m.nx + i), ny = load<T>(m.ny + i), nz = load<T>(m.nz + i);
+  const T noise = kinect_axial_noise_m(z);
+  const T scaled_noise = p.convexity_noise_k * noise;
+  const T epsilon =
+      scaled_noise > p.convexity_epsilon_m ? scaled_noise : T{} + p.convexity_epsilon_m;
   T convexity = T{} + 1.0f, distance = T{};
   Mask discontinuity = Mask{};
   for (int k = 0; k < 8; ++k) {
@@ -71,7 +75,7 @@ template <class T, bool kCheckBounds = false>
     const T along_normal = (jx - vx) * nx + (jy - vy) * ny + (jz - z) * nz;
     const T cosine = nx * jnx + ny * jny + nz * jnz;
     const Mask convex_candidate =
-        valid & (along_normal > p.convexity_epsilon_m) & ((jnx != 0) | (jny != 0) | (jnz != 0));
+        valid & (along_normal > epsilon) & ((jnx != 0) | (jny != 0) | (jnz != 0));
     convexity = convex_candidate & (cosine < convexity) ? cosine : convexity;
     const T magnitude = along_normal < 0 ? -along_normal : along_normal;
     distance = valid & (distance < magnitude) ? magnitude : distance;
@@ -80,7 +84,7 @@ template <class T, bool kCheckBounds = false>
   }
   // No depth or no normal: an edge.
   return (z <= 0) | ((nx == 0) & (ny == 0) & (nz == 0)) | (convexity < p.min_convexity) |
-         (distance > p.distance_k * kinect_axial_noise_m(z)) | discontinuity;
+         (distance > p.distance_k * noise) | discontinuity;
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 // connected regions between concave boundaries and depth discontinuities.
 //   vertex map V and normals N (central differences, facing the camera)
 //   concavity  phi_c(u) = min_i [1 if (v_i - v).n <= eps else n.n_i]   edge if phi_c < tau_c
+//              (eps grows with the sensor noise sigma(z), see DepthSegmentationParams)
 //   distance   phi_d(u) = max_i |(v_i - v).n|                          edge if phi_d > k sigma(z)
 //   plus a depth-discontinuity test |z_i - z| / z > ratio
 // with sigma(z) = 0.0012 + 0.0019 (z - 0.4)^2 m, Kinect's axial noise (Nguyen et al. 2012).
@@ -18,14 +19,21 @@
 namespace glint::reflectance {
 
 struct DepthSegmentationParams {
-  int normal_step_px = 2;               // central-difference offset for normals
-  int neighbour_step_px = 2;            // the 8 neighbours v_i sit this many pixels away
-  float convexity_epsilon_m = 0.0005f;  // eps: neighbours this far in front still count convex
-  float min_convexity = 0.94f;          // tau_c
-  float distance_k = 6.0f;              // k in k sigma(z)
-  float discontinuity_ratio = 0.05f;    // |dz| / z
-  int min_segment_px = 300;             // smaller components become unlabelled (0)
-  int fill_radius_px = 4;               // edge pixels take a label from this window
+  int normal_step_px = 2;     // central-difference offset for normals
+  int neighbour_step_px = 2;  // the 8 neighbours v_i sit this many pixels away
+  // eps = max(convexity_epsilon_m, convexity_noise_k sigma(z)): neighbours this far in front of
+  // the tangent plane still count convex. Within the sensor's noise the side a neighbour lies on
+  // is noise, and n.n_i of noisy normals often falls below tau_c. On 7-Scenes' kitchen (Kinect
+  // v1, 1-3 m; means over its 50 frames) a fixed 0.5 mm marked 62 % of the valid pixels as edges
+  // and left 59 % unlabelled; 0.5 sigma(z): 51 % and 27 %. A concave corner's neighbours lie
+  // centimetres in front (neighbour_step_px apart), well beyond it.
+  float convexity_epsilon_m = 0.0005f;
+  float convexity_noise_k = 0.5f;
+  float min_convexity = 0.94f;        // tau_c
+  float distance_k = 6.0f;            // k in k sigma(z)
+  float discontinuity_ratio = 0.05f;  // |dz| / z
+  int min_segment_px = 300;           // smaller components become unlabelled (0)
+  int fill_radius_px = 4;             // edge pixels take a label from this window
 };
 
 struct DepthSegmentation {

@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <functional>
+#include <map>
+#include <random>
 #include <set>
 #include <utility>
 
@@ -10,16 +13,46 @@ namespace glint::reflectance {
 namespace {
 
 const Intrinsics kCamera{128, 96, 100.0, 100.0, 63.5, 47.5};
+// A Kinect's field of view at the pipeline's half resolution (fx = 585 / 2): neighbours 2 pixels
+// apart lie under 2 cm apart at 2.5 m, not far beyond the noise.
+const Intrinsics kKinectHalf{128, 96, 292.5, 292.5, 63.5, 47.5};
 
 // A depth image whose pixel (u, v) has depth depth_of(a, b) for the ray (a, b, 1).
-ImageF depth_image(const std::function<float(double, double)>& depth_of) {
-  ImageF depth(kCamera.width, kCamera.height, 1);
-  for (int v = 0; v < kCamera.height; ++v)
-    for (int u = 0; u < kCamera.width; ++u) {
-      const Eigen::Vector3d ray = kCamera.ray(u, v);
+ImageF depth_image(const std::function<float(double, double)>& depth_of,
+                   const Intrinsics& camera = kCamera) {
+  ImageF depth(camera.width, camera.height, 1);
+  for (int v = 0; v < camera.height; ++v)
+    for (int u = 0; u < camera.width; ++u) {
+      const Eigen::Vector3d ray = camera.ray(u, v);
       depth.at(u, v, 0) = depth_of(ray.x(), ray.y());
     }
   return depth;
+}
+
+// depth_of's image at kKinectHalf with Gaussian noise of 0.75 sigma(z) (core/camera.h's Kinect
+// noise per pixel: the pipeline's 2x2 average would halve independent noise, but a Kinect's is
+// correlated over several pixels), seeded.
+ImageF noisy_depth_image(const std::function<float(double, double)>& depth_of) {
+  ImageF depth = depth_image(depth_of, kKinectHalf);
+  std::mt19937 random(7);
+  std::normal_distribution<float> unit;
+  for (float& z : depth.values()) z += 0.75f * kinect_axial_noise_m(z) * unit(random);
+  return depth;
+}
+
+// Pixels per label (0 included) in columns [x0, x1) of the rows away from the border.
+std::map<int, int> label_areas(const DepthSegmentation& s, int x0, int x1) {
+  std::map<int, int> area;
+  for (int y = 10; y < kCamera.height - 10; ++y)
+    for (int x = x0; x < x1; ++x) ++area[s.labels.at(x, y, 0)];
+  return area;
+}
+
+int largest_labelled_area(const std::map<int, int>& areas) {
+  int largest = 0;
+  for (const auto& [label, area] : areas)
+    if (label > 0) largest = std::max(largest, area);
+  return largest;
 }
 
 std::set<int> labels_in_columns(const DepthSegmentation& s, int x0, int x1) {
@@ -84,6 +117,36 @@ TEST(DepthSegmentation, ASegmenterReusedAcrossFramesAndSizesMatchesAFreshOne) {
           ASSERT_EQ(reused.edges.at(x, y, 0), fresh.edges.at(x, y, 0));
         }
     }
+}
+
+TEST(DepthSegmentation, ANoisyWallStaysOneSegment) {
+  // A slanted wall 1.9-3.6 m away: within the noise, whether a neighbour lies in front of the
+  // tangent plane says nothing about concavity.
+  const ImageF wall = noisy_depth_image([](double a, double) { return 2.5 / (1 + 1.5 * a); });
+  const int pixels = (kCamera.width - 20) * (kCamera.height - 20);
+  EXPECT_GT(largest_labelled_area(label_areas(segment_depth(wall, kKinectHalf), 10, 118)),
+            0.9 * pixels);
+  // A fixed 0.5 mm tolerance, as before, shatters it.
+  DepthSegmentationParams fixed;
+  fixed.convexity_noise_k = 0;
+  EXPECT_LT(largest_labelled_area(label_areas(segment_depth(wall, kKinectHalf, fixed), 10, 118)),
+            0.5 * pixels);
+}
+
+TEST(DepthSegmentation, ANoisyConcaveCornerStillSplits) {
+  // The inside of a room corner, as in AConcaveCornerSplitsIntoTwoSegments, 1.2-2 m away.
+  const auto s = segment_depth(
+      noisy_depth_image([](double a, double) { return 2 / (1 + 3 * std::abs(a)); }), kKinectHalf);
+  const auto left = label_areas(s, 10, 54), right = label_areas(s, 74, 118);
+  const int side = 44 * (kCamera.height - 20);
+  const auto main_label = [](const std::map<int, int>& areas) {
+    return std::max_element(areas.begin(), areas.end(),
+                            [](const auto& a, const auto& b) { return a.second < b.second; })
+        ->first;
+  };
+  EXPECT_GT(largest_labelled_area(left), 0.8 * side);
+  EXPECT_GT(largest_labelled_area(right), 0.8 * side);
+  EXPECT_NE(main_label(left), main_label(right));
 }
 
 TEST(DepthSegmentation, NoDepthGivesNoSegments) {
