@@ -255,6 +255,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"render_normal_radius_m", options.render_normal_radius_m},
          {"ground_truth_poses", options.params.geometry.use_ground_truth_poses},
          {"ground_truth_segmentation", options.ground_truth_segmentation},
+         {"segment_noise", options.params.segmentation.convexity_noise_k},
          {"exposure", options.params.exposure},
          {"model", model_path},
          {"lights", lights.capture}}},
@@ -337,6 +338,14 @@ void register_reconstruct_command(CLI::App& app) {
   command->add_option("--views", options->views,
                       "TUM trajectory (camera-to-world) of extra poses to re-render the final "
                       "model from, into OUT/views/");
+  command
+      ->add_option("--segment-noise", params.segmentation.convexity_noise_k,
+                   "Depth segmentation: a neighbour within this many Kinect noise sigmas (Nguyen "
+                   "et al.: 1.2 mm + 1.9 mm (z - 0.4 m)^2) in front of a pixel's tangent plane "
+                   "still counts convex, so sensor noise does not cut surfaces into fragments; "
+                   "lower it for a less noisy sensor (0 = a fixed 0.5 mm)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   command
       ->add_option("--albedo-every", params.albedo_refresh_frames,
                    "Re-solve each visible voxel's albedo every N frames (staggered)")
