@@ -344,7 +344,7 @@ void register_reconstruct_command(CLI::App& app) {
                    "et al.: 1.2 mm + 1.9 mm (z - 0.4 m)^2) in front of a pixel's tangent plane "
                    "still counts convex, so sensor noise does not cut surfaces into fragments; "
                    "lower it for a less noisy sensor (0 = a fixed 0.5 mm)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(CLI::Range(0.0f, 10.0f))
       ->capture_default_str();
   command
       ->add_option("--albedo-every", params.albedo_refresh_frames,
