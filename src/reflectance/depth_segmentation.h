@@ -24,8 +24,8 @@ struct DepthSegmentationParams {
   // eps = max(convexity_epsilon_m, convexity_noise_k sigma(z)): neighbours this far in front of
   // the tangent plane still count convex. Within the sensor's noise the side a neighbour lies on
   // is noise, and n.n_i of noisy normals often falls below tau_c. On 7-Scenes' kitchen (Kinect
-  // v1, 1-3 m; means over its 50 frames) a fixed 0.5 mm marked 62 % of the valid pixels as edges
-  // and left 59 % unlabelled; 0.5 sigma(z): 51 % and 27 %. A concave corner's neighbours lie
+  // v1; means over its 50 frames) a fixed 0.5 mm marked 62 % of the valid pixels as edges and
+  // left 59 % unlabelled; 0.5 sigma(z): 51 % and 27 %. A concave corner's neighbours lie
   // centimetres in front (neighbour_step_px apart), well beyond it.
   float convexity_epsilon_m = 0.0005f;
   float convexity_noise_k = 0.5f;

@@ -120,7 +120,7 @@ TEST(DepthSegmentation, ASegmenterReusedAcrossFramesAndSizesMatchesAFreshOne) {
 }
 
 TEST(DepthSegmentation, ANoisyWallStaysOneSegment) {
-  // A slanted wall 1.9-3.6 m away: within the noise, whether a neighbour lies in front of the
+  // A slanted wall 1.9-3.7 m away: within the noise, whether a neighbour lies in front of the
   // tangent plane says nothing about concavity.
   const ImageF wall = noisy_depth_image([](double a, double) { return 2.5 / (1 + 1.5 * a); });
   const int pixels = (kCamera.width - 20) * (kCamera.height - 20);
