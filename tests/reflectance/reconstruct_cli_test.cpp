@@ -58,10 +58,12 @@ TEST_F(ReconstructCli, WritesTheModelMaterialsLightsPicturesAndReport) {
 TEST_F(ReconstructCli, OwnSegmentationRuns) {
   const CommandResult result =
       glint("reconstruct " + path("seq") + " --gt-lights --model " + path("model.json") +
-            " --gt-poses --eval-every 0 -o " + path("own"));
+            " --gt-poses --eval-every 0 --segment-noise 1 -o " + path("own") + " --report " +
+            path("own.json"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const nlohmann::json materials = io::read_json(path("own") + "/materials.json");
   EXPECT_GE(materials["segments"].size(), 1u);
+  EXPECT_FLOAT_EQ(io::read_json(path("own.json"))["parameters"]["segment_noise"].get<float>(), 1);
 }
 
 TEST_F(ReconstructCli, BadInputsFailClearly) {
@@ -80,6 +82,9 @@ TEST_F(ReconstructCli, BadInputsFailClearly) {
       glint("reconstruct " + path("seq") + " --gt-lights --albedo-smoothing -0.1 -o " + path("x"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("--albedo-smoothing"), std::string::npos) << result.output;
+  result = glint("reconstruct " + path("seq") + " --gt-lights --segment-noise 11 -o " + path("x"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("--segment-noise"), std::string::npos) << result.output;
   result = glint("reconstruct " + path("seq") + " --gt-lights --device gpu -o " + path("x"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("--device"), std::string::npos) << result.output;
