@@ -18,7 +18,7 @@ BlockOccupancy::BlockOccupancy(const TsdfVolume& volume) {
   const Eigen::Matrix<std::uint64_t, 3, 1> size =
       (high - low_).cast<std::int64_t>().cast<std::uint64_t>() +
       Eigen::Matrix<std::uint64_t, 3, 1>::Ones();
-  if (size.x() * size.y() * size.z() > kMaxBits) return;  // holds() says "maybe" to all
+  if (size.x() * size.y() * size.z() > kMaxBits) return;  // may_hold() says "maybe" to all
   size_ = size.cast<int>();
   words_.assign((size.x() * size.y() * size.z() + 63) / 64, 0);
   for (std::size_t i = 0; i < blocks; ++i) {

@@ -55,10 +55,10 @@ int largest_labelled_area(const std::map<int, int>& areas) {
   return largest;
 }
 
+// The labels (0 included) in those columns.
 std::set<int> labels_in_columns(const DepthSegmentation& s, int x0, int x1) {
   std::set<int> found;
-  for (int y = 10; y < kCamera.height - 10; ++y)
-    for (int x = x0; x < x1; ++x) found.insert(s.labels.at(x, y, 0));
+  for (const auto& [label, area] : label_areas(s, x0, x1)) found.insert(label);
   return found;
 }
 
