@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 
+#include "core/parallel.h"
 #include "fusion_test_support.h"
 
 namespace glint::fusion {
@@ -49,6 +50,49 @@ TEST_F(IcpTracker, RecoversAKnownRigidMotion) {
   EXPECT_LT(error.translation().norm(), 0.002);
   EXPECT_LT(Eigen::AngleAxisd(error.rotation()).angle(), 0.002);
   EXPECT_LT(result.rmse_m, 0.005);
+}
+
+// A moved camera whose frame is 83 x 61 pixels: the association's 8-pixel groups end in partial
+// ones.
+Pose moved_pose() {
+  Pose moved = Pose::Identity();
+  moved.linear() =
+      Eigen::AngleAxisd(0.02, Eigen::Vector3d(-0.5, 1, 0.3).normalized()).toRotationMatrix();
+  moved.translation() = Eigen::Vector3d(-0.015, 0.01, 0.02);
+  return moved;
+}
+const Intrinsics kOddCamera{83, 61, 72.0, 72.0, 41.0, 30.0};
+
+TEST_F(IcpTracker, RecoversTheMotionAgainstAHalfResolutionModel) {
+  const Pose reference = Pose::Identity(), moved = moved_pose();
+  const Intrinsics half = kOddCamera.scaled(0.5);
+  const SurfaceView model = raycast(volume_, half, reference);
+  const SurfaceView frame = raycast(volume_, kOddCamera, moved);
+  const TrackingResult result =
+      track_frame(frame.depth_m, kOddCamera, model, half, reference, reference);
+  ASSERT_EQ(result.status, TrackingStatus::tracked);
+  const Pose error = result.camera_to_world.inverse() * moved;
+  EXPECT_LT(error.translation().norm(), 0.003);
+  EXPECT_LT(Eigen::AngleAxisd(error.rotation()).angle(), 0.003);
+}
+
+TEST_F(IcpTracker, TheEstimateDoesNotDependOnTheNumberOfThreads) {
+  const Pose reference = Pose::Identity(), moved = moved_pose();
+  const SurfaceView model = raycast(volume_, kOddCamera, reference);
+  const SurfaceView frame = raycast(volume_, kOddCamera, moved);
+  const auto track = [&] {
+    return track_frame(frame.depth_m, kOddCamera, model, kOddCamera, reference, reference);
+  };
+  const TrackingResult parallel = track();
+  TrackingResult serial;
+  {
+    const auto one_thread = limit_threads(1);
+    serial = track();
+  }
+  ASSERT_EQ(parallel.status, TrackingStatus::tracked);
+  EXPECT_EQ(parallel.inliers, serial.inliers);
+  EXPECT_EQ(parallel.rmse_m, serial.rmse_m);
+  EXPECT_TRUE(parallel.camera_to_world.matrix() == serial.camera_to_world.matrix());
 }
 
 TEST_F(IcpTracker, EmptyFrameIsLostNotACrash) {
