@@ -1,4 +1,5 @@
-// Normal maps: edge-aware smoothing of ray-cast normals.
+// Depth and normal maps: the bilateral depth filter against its definition, edge-aware smoothing
+// of ray-cast normals.
 #include "fusion/depth_maps.h"
 
 #include <gtest/gtest.h>
@@ -80,6 +81,62 @@ TEST(SmoothNormals, ExactNormalsOfAPlaneStayExact) {
   for (int y = 0; y < kCamera.height; ++y)
     for (int x = 0; x < kCamera.width; ++x)
       ASSERT_LT(angle_deg(smoothed, ridge.true_normals, x, y), 0.05f) << x << ", " << y;
+}
+
+// The bilateral filter's definition, pixel by pixel: the mean of the window's pixels with depth,
+// weighted by exp(-dist^2 / 2 sigma_space^2) exp(-(d - centre)^2 / 2 sigma_depth^2).
+ImageF bilateral_by_definition(const ImageF& depth, const BilateralParams& params) {
+  ImageF out(depth.width(), depth.height(), 1);
+  for (int y = 0; y < depth.height(); ++y)
+    for (int x = 0; x < depth.width(); ++x) {
+      const double centre = depth.at(x, y, 0);
+      if (!(centre > 0)) continue;
+      double sum = 0, weights = 0;
+      for (int v = y - params.radius_px; v <= y + params.radius_px; ++v)
+        for (int u = x - params.radius_px; u <= x + params.radius_px; ++u) {
+          if (u < 0 || v < 0 || u >= depth.width() || v >= depth.height()) continue;
+          const double d = depth.at(u, v, 0);
+          if (!(d > 0)) continue;
+          const double w = std::exp(-((u - x) * (u - x) + (v - y) * (v - y)) /
+                                    (2 * params.sigma_space_px * params.sigma_space_px)) *
+                           std::exp(-(d - centre) * (d - centre) /
+                                    (2 * params.sigma_depth_m * params.sigma_depth_m));
+          sum += w * d;
+          weights += w;
+        }
+      out.at(x, y, 0) = float(sum / weights);
+    }
+  return out;
+}
+
+TEST(BilateralFilterDepth, MatchesItsDefinitionWithHolesStepsAndBorders) {
+  // 37 x 23: rows not a multiple of the vector width; noise on a step from 1.2 m to 2.5 m, holes.
+  ImageF depth(37, 23, 1);
+  std::mt19937 rng(3);
+  std::normal_distribution<float> noise(0.0f, 0.01f);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  for (int y = 0; y < depth.height(); ++y)
+    for (int x = 0; x < depth.width(); ++x)
+      depth.at(x, y, 0) = uniform(rng) < 0.1f ? 0.0f : (x < 17 ? 1.2f : 2.5f) + noise(rng);
+  depth.at(30, 2, 0) = 60.0f;  // far beyond the range term's reach: must not disturb its neighbours
+  // Depths a few centimetres from 0, where only the mask keeps the holes beside them out.
+  for (int x = 0; x < 9; ++x) depth.at(x, 20, 0) = x % 3 == 0 ? 0.0f : 0.03f + 0.001f * x;
+  const BilateralParams params;
+  const ImageF filtered = bilateral_filter_depth(depth, params);
+  const ImageF expected = bilateral_by_definition(depth, params);
+  for (int y = 0; y < depth.height(); ++y)
+    for (int x = 0; x < depth.width(); ++x) {
+      EXPECT_NEAR(filtered.at(x, y, 0), expected.at(x, y, 0), 2e-6f * expected.at(x, y, 0))
+          << x << ", " << y;
+      EXPECT_EQ(filtered.at(x, y, 0) > 0, depth.at(x, y, 0) > 0) << "holes stay holes";
+    }
+}
+
+TEST(BilateralFilterDepth, AConstantDepthStaysConstant) {
+  const ImageF depth(19, 11, 1, 1.75f);
+  const ImageF filtered = bilateral_filter_depth(depth, {});
+  for (int y = 0; y < depth.height(); ++y)
+    for (int x = 0; x < depth.width(); ++x) EXPECT_FLOAT_EQ(filtered.at(x, y, 0), 1.75f);
 }
 
 }  // namespace
