@@ -108,34 +108,36 @@ void run_fuse(const FuseOptions& options) {
       ate.is_null() ? std::string()
                     : fmt::format(", ATE RMSE {:.4f} m", ate["rmse_m"].get<double>()));
   if (!options.report.empty())
-    io::write_json(options.report, {{"command", command_line()},
-                                    {"input", options.dataset},
-                                    {"format", sequence.format},
-                                    {"frames", frames},
-                                    {"intrinsics",
-                                     {{"width", sequence.intrinsics.width},
-                                      {"height", sequence.intrinsics.height},
-                                      {"fx", sequence.intrinsics.fx},
-                                      {"fy", sequence.intrinsics.fy},
-                                      {"cx", sequence.intrinsics.cx},
-                                      {"cy", sequence.intrinsics.cy}}},
-                                    {"parameters",
-                                     {{"voxel_size_m", volume.voxel_size_m},
-                                      {"truncation_m", volume.truncation_m},
-                                      {"truncation_per_depth", volume.truncation_per_depth},
-                                      {"depth_max_m", volume.depth_max_m},
-                                      {"block_capacity", volume.block_capacity},
-                                      {"ground_truth_poses", !tracked},
-                                      {"integration_device", pipeline.integration_device()}}},
-                                    {"blocks", pipeline.volume().block_count()},
-                                    {"mesh",
-                                     {{"vertices", mesh.vertices.size()},
-                                      {"triangles", mesh.triangles.size()},
-                                      {"path", options.mesh}}},
-                                    {"tracking_lost_frames", lost},
-                                    {"ate", ate},
-                                    {"timings_ms", timings},
-                                    {"total_s", total.elapsed_s()}});
+    io::write_json(options.report,
+                   {{"command", command_line()},
+                    {"input", options.dataset},
+                    {"format", sequence.format},
+                    {"frames", frames},
+                    {"intrinsics",
+                     {{"width", sequence.intrinsics.width},
+                      {"height", sequence.intrinsics.height},
+                      {"fx", sequence.intrinsics.fx},
+                      {"fy", sequence.intrinsics.fy},
+                      {"cx", sequence.intrinsics.cx},
+                      {"cy", sequence.intrinsics.cy}}},
+                    {"parameters",
+                     {{"voxel_size_m", volume.voxel_size_m},
+                      {"truncation_m", volume.truncation_m},
+                      {"truncation_per_depth", volume.truncation_per_depth},
+                      {"depth_max_m", volume.depth_max_m},
+                      {"block_capacity", volume.block_capacity},
+                      {"ground_truth_poses", !tracked},
+                      {"track_model_halvings", options.params.tracking.model_halvings},
+                      {"integration_device", pipeline.integration_device()}}},
+                    {"blocks", pipeline.volume().block_count()},
+                    {"mesh",
+                     {{"vertices", mesh.vertices.size()},
+                      {"triangles", mesh.triangles.size()},
+                      {"path", options.mesh}}},
+                    {"tracking_lost_frames", lost},
+                    {"ate", ate},
+                    {"timings_ms", timings},
+                    {"total_s", total.elapsed_s()}});
 }
 
 }  // namespace
@@ -176,6 +178,15 @@ void add_volume_options(CLI::App* command, fusion::VolumeParams& volume) {
       ->capture_default_str();
 }
 
+void add_tracking_options(CLI::App* command, fusion::TrackingParams& tracking) {
+  command
+      ->add_option("--track-model-halvings", tracking.model_halvings,
+                   "Tracking: ray cast the model it aligns each frame to at the frame's resolution "
+                   "halved this many times (the ray cast is most of a tracked frame's time)")
+      ->check(CLI::Range(0, 2))
+      ->capture_default_str();
+}
+
 void add_integration_device_option(CLI::App* command, fusion::IntegrationDevice& device) {
   device = fusion::IntegrationDevice::automatic;
   command
@@ -205,6 +216,7 @@ void register_fuse_command(CLI::App& app) {
   command->add_option("-o,--output", options->mesh, "Mesh (PLY, binary, sRGB vertex colours)")
       ->required();
   add_volume_options(command, options->params.volume);
+  add_tracking_options(command, options->params.tracking);
   add_integration_device_option(command, options->params.device);
   command->add_flag("--gt-poses", options->params.use_ground_truth_poses,
                     "Use the dataset's ground-truth poses instead of tracking");

@@ -254,6 +254,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"normals", normals_name(options.params.observations)},
          {"render_normal_radius_m", options.render_normal_radius_m},
          {"ground_truth_poses", options.params.geometry.use_ground_truth_poses},
+         {"track_model_halvings", options.params.geometry.tracking.model_halvings},
          {"ground_truth_segmentation", options.ground_truth_segmentation},
          {"segment_noise", options.params.segmentation.convexity_noise_k},
          {"exposure", options.params.exposure},
@@ -314,6 +315,7 @@ void register_reconstruct_command(CLI::App& app) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   add_volume_options(command, params.geometry.volume);
+  add_tracking_options(command, params.geometry.tracking);
   add_integration_device_option(command, params.geometry.device);
   command->add_flag("--gt-poses", params.geometry.use_ground_truth_poses,
                     "Use the dataset's ground-truth poses instead of tracking");

@@ -1,5 +1,7 @@
 #include "fusion/fusion_pipeline.h"
 
+#include <cmath>
+
 #include "core/error.h"
 
 namespace glint::fusion {
@@ -17,6 +19,10 @@ Pose FusionPipeline::predict_pose() const {
   return last * (poses_[poses_.size() - 2].inverse() * last);
 }
 
+Intrinsics FusionPipeline::model_intrinsics() const {
+  return intrinsics_.scaled(std::ldexp(1.0, -params_.tracking.model_halvings));
+}
+
 FrameResult FusionPipeline::process(const io::RgbdFrame& frame) {
   FrameResult result;
   if (params_.use_ground_truth_poses) {
@@ -28,8 +34,8 @@ FrameResult FusionPipeline::process(const io::RgbdFrame& frame) {
     result.camera_to_world = frame.ground_truth.value_or(Pose::Identity());
   } else {
     Stopwatch watch;
-    result.tracking = track_frame(frame.depth_m, intrinsics_, model_, intrinsics_, poses_.back(),
-                                  predict_pose(), params_.tracking);
+    result.tracking = track_frame(frame.depth_m, intrinsics_, model_, model_intrinsics(),
+                                  poses_.back(), predict_pose(), params_.tracking);
     timings_.add("track", watch.elapsed_ms());
     result.camera_to_world = result.tracking->status == TrackingStatus::tracked
                                  ? result.tracking->camera_to_world
@@ -56,7 +62,7 @@ FrameResult FusionPipeline::process(const io::RgbdFrame& frame) {
   }
   if (!params_.use_ground_truth_poses) {
     Stopwatch watch;
-    model_ = raycast(volume_, intrinsics_, result.camera_to_world);
+    model_ = raycast(volume_, model_intrinsics(), result.camera_to_world);
     timings_.add("raycast", watch.elapsed_ms());
   }
   return result;

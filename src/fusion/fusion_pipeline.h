@@ -53,6 +53,7 @@ class FusionPipeline {
 
  private:
   Pose predict_pose() const;
+  Intrinsics model_intrinsics() const;  // of the ray-cast model tracking aligns to
 
   Intrinsics intrinsics_;
   FusionParams params_;

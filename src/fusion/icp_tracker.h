@@ -25,6 +25,9 @@ struct TrackingParams {
   // A solution with fewer inlier pairs than this fraction of the finest level's pixels, or an
   // ill-conditioned system, counts as lost.
   double min_inlier_fraction = 0.05;
+  // The model is ray cast at the frame's resolution halved this many times (FusionPipeline):
+  // the frame's points associate with the nearest model pixel either way.
+  int model_halvings = 0;
 };
 
 enum class TrackingStatus { tracked, lost };

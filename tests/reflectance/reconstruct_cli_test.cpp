@@ -66,6 +66,20 @@ TEST_F(ReconstructCli, OwnSegmentationRuns) {
   EXPECT_FLOAT_EQ(io::read_json(path("own.json"))["parameters"]["segment_noise"].get<float>(), 1);
 }
 
+// Without --gt-poses: the frames are tracked, here against a model ray cast at half resolution.
+TEST_F(ReconstructCli, TracksTheCameraAgainstAHalfResolutionModel) {
+  const CommandResult result =
+      glint("reconstruct " + path("seq") + " --gt-lights --gt-segmentation --model " +
+            path("model.json") + " --track-model-halvings 1 --eval-every 0 -o " + path("tracked") +
+            " --report " + path("tracked.json"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const nlohmann::json report = io::read_json(path("tracked.json"));
+  EXPECT_EQ(report["parameters"]["track_model_halvings"], 1);
+  EXPECT_EQ(report["parameters"]["ground_truth_poses"], false);
+  EXPECT_EQ(report["tracking_lost_frames"], 0);
+  EXPECT_GE(io::read_json(path("tracked") + "/materials.json")["segments"].size(), 2u);
+}
+
 TEST_F(ReconstructCli, BadInputsFailClearly) {
   CommandResult result =
       glint("reconstruct " + path("seq") + " --model " + path("model.json") + " -o " + path("x"));
@@ -85,6 +99,10 @@ TEST_F(ReconstructCli, BadInputsFailClearly) {
   result = glint("reconstruct " + path("seq") + " --gt-lights --segment-noise 11 -o " + path("x"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("--segment-noise"), std::string::npos) << result.output;
+  result =
+      glint("reconstruct " + path("seq") + " --gt-lights --track-model-halvings 3 -o " + path("x"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("--track-model-halvings"), std::string::npos) << result.output;
   result = glint("reconstruct " + path("seq") + " --gt-lights --device gpu -o " + path("x"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("--device"), std::string::npos) << result.output;
