@@ -261,6 +261,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"model", model_path},
          {"lights", lights.capture}}},
        {"timings_ms", timings.to_json()},
+       {"geometry_timings_ms", pipeline.geometry_timings().to_json()},
        {"command_timings_ms", command},
        {"materials", materials_json(pipeline)},
        {"evaluation", has_truth ? evaluation.to_json() : nlohmann::json(nullptr)},

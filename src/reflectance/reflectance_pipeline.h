@@ -93,6 +93,9 @@ class ReflectancePipeline {
   const SpecularEstimator& materials() const { return specular_; }
   const std::vector<render::PointLight>& lights() const { return lights_; }
   const StageTimings& timings() const { return timings_; }
+  // The geometry stage's parts: "track", "raycast" (the model tracking aligns to; both only
+  // without ground-truth poses), "allocate_blocks", "integrate".
+  const StageTimings& geometry_timings() const { return geometry_.timings(); }
   const Intrinsics& intrinsics() const { return intrinsics_; }
   float exposure() const { return params_.exposure; }
   float albedo_smoothing() const { return params_.albedo_smoothing; }

@@ -77,6 +77,10 @@ TEST_F(ReconstructCli, TracksTheCameraAgainstAHalfResolutionModel) {
   EXPECT_EQ(report["parameters"]["track_model_halvings"], 1);
   EXPECT_EQ(report["parameters"]["ground_truth_poses"], false);
   EXPECT_EQ(report["tracking_lost_frames"], 0);
+  // The geometry stage's parts: every frame after the first is tracked against a ray cast.
+  EXPECT_EQ(report["geometry_timings_ms"]["track"]["count"], 23);
+  EXPECT_EQ(report["geometry_timings_ms"]["raycast"]["count"], 24);
+  EXPECT_EQ(report["geometry_timings_ms"]["integrate"]["count"], 24);
   EXPECT_GE(io::read_json(path("tracked") + "/materials.json")["segments"].size(), 2u);
 }
 
