@@ -10,9 +10,8 @@
 #include <limits>
 #include <numbers>
 #include <vector>
-#if defined(__x86_64__)
-#include <immintrin.h>
-#endif
+
+#include "fusion/vector_lanes.h"
 
 namespace glint::fusion {
 namespace {
@@ -71,12 +70,9 @@ struct Association {
   float max_squared_distance, cos_max_angle;
 };
 
-// Eight pixels at a time in GCC vector lanes (one AVX2 register where the CPU has x86-64-v3, SSE
-// pairs otherwise): pixel by pixel, the sums' 27 dependent double additions per pair were most
-// of a tracked frame's association time.
-constexpr int kLanes = 8;
-using Floats = float __attribute__((vector_size(kLanes * sizeof(float))));
-using Ints = std::int32_t __attribute__((vector_size(kLanes * sizeof(std::int32_t))));
+// Eight pixels at a time in vector lanes (vector_lanes.h): pixel by pixel, the sums' 27
+// dependent double additions per pair were most of a tracked frame's association time.
+constexpr int kLanes = kLaneCount;
 
 // Lane-wise sums of a range's pairs, in float: a range holds at most a few thousand pixels, a few
 // hundred per lane.
@@ -85,8 +81,7 @@ struct LaneSums {
   Ints count;
 };
 
-// Clears the lanes of `mask` where x is NaN or infinite. (Vectors are passed by reference: the
-// calling convention of a by-value vector differs between the baseline and the AVX2 code.)
+// Clears the lanes of `mask` where x is NaN or infinite.
 [[gnu::always_inline]] inline void keep_finite(Ints& mask, const Floats& x) {
   mask &= (x - x) == 0;
 }
@@ -127,14 +122,11 @@ template <auto gather>
   for (int r = 0; r < 3; ++r)
     in_model[r] = a.model_rotation[r][0] * world[0] + a.model_rotation[r][1] * world[1] +
                   a.model_rotation[r][2] * world[2] + a.model_translation[r];
-  // nearest_pixel() for every lane.
   const Floats u = a.fx * in_model[0] / in_model[2] + a.cx;
   const Floats v = a.fy * in_model[1] / in_model[2] + a.cy;
-  valid &= (in_model[2] > 0) & (u >= -0.5f) & (v >= -0.5f) & (u < float(a.model_width) - 0.5f) &
-           (v < float(a.model_height) - 0.5f);
-  const Ints column = __builtin_convertvector(valid ? u + 0.5f : Floats{}, Ints);
-  const Ints row = __builtin_convertvector(valid ? v + 0.5f : Floats{}, Ints);
-  const Ints pixel = row * a.model_width + column;
+  valid &= in_model[2] > 0;
+  Ints pixel;
+  nearest_pixels(u, v, a.model_width, a.model_height, valid, pixel);
   Floats q[3], m[3];
   for (int axis = 0; axis < 3; ++axis) {
     gather(a.q[axis], pixel, q[axis]);
@@ -162,20 +154,6 @@ template <auto gather>
   sums.squared_error += residual * residual;
   sums.count -= valid;  // a true lane is -1
 }
-
-// plane[pixel] for each lane: lane by lane, or one vgatherdps where the CPU has AVX2.
-[[gnu::always_inline]] inline void gather_lane_by_lane(const float* plane, const Ints& pixel,
-                                                       Floats& out) {
-  float values[kLanes];
-  for (int lane = 0; lane < kLanes; ++lane) values[lane] = plane[pixel[lane]];
-  std::memcpy(&out, values, sizeof(out));
-}
-#if defined(__x86_64__)
-[[gnu::target("avx2")]] inline void gather_avx2(const float* plane, const Ints& pixel,
-                                                Floats& out) {
-  out = Floats(_mm256_i32gather_ps(plane, __m256i(pixel), sizeof(float)));
-}
-#endif
 
 template <auto gather>
 [[gnu::always_inline]] inline void sum_range(const Association& a, std::size_t begin,

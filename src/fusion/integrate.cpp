@@ -16,6 +16,7 @@
 #include "core/parallel.h"
 #include "fusion/integrate_frame.h"
 #include "fusion/tsdf_kernels.h"
+#include "fusion/vector_lanes.h"
 
 namespace glint::fusion {
 namespace {
@@ -88,28 +89,12 @@ void allocate_blocks(TsdfVolume& volume, const ImageF& depth_m, const Intrinsics
 
 namespace {
 
-// A block is fused one x-row (kBlockSide voxels) at a time as GCC vector lanes: one AVX2
-// register where the CPU has x86-64-v3 (the build's baseline is plain x86-64, so the block
-// kernel is compiled twice and picked once at run time), SSE pairs otherwise. Where the CPU has
-// AVX-512 (x86-64-v4), integrate_block_x86_64_v4() fuses two rows per register instead.
-using Floats = float __attribute__((vector_size(kBlockSide * sizeof(float))));
-using Ints = std::int32_t __attribute__((vector_size(kBlockSide * sizeof(std::int32_t))));
+// A block is fused one x-row (kBlockSide voxels) at a time as vector lanes (vector_lanes.h; the
+// build's baseline is plain x86-64, so the block kernel is compiled twice and picked once at
+// run time). Where the CPU has AVX-512 (x86-64-v4), integrate_block_x86_64_v4() fuses two rows
+// per register instead.
+static_assert(kBlockSide == kLaneCount);
 constexpr Floats kLanes{0, 1, 2, 3, 4, 5, 6, 7};
-
-// The depth under each lane's pixel. (Vectors are passed by reference: the calling convention
-// of a by-value vector differs between the baseline and the AVX2 code.)
-[[gnu::always_inline]] inline void depth_lane_by_lane(const float* depth, const Ints& pixel,
-                                                      Floats& d) {
-  for (int lane = 0; lane < kBlockSide; ++lane) d[lane] = depth[pixel[lane]];
-}
-#if defined(__x86_64__)
-// One vgatherdps instead of 8 extract-load-insert triples: integration is bound by instruction
-// throughput, and they were a quarter of each row's instructions.
-[[gnu::target("avx2")]] inline void depth_gathered(const float* depth, const Ints& pixel,
-                                                   Floats& d) {
-  d = Floats(_mm256_i32gather_ps(depth, __m256i(pixel), sizeof(float)));
-}
-#endif
 
 // Fuses the row whose voxel centres are first + i * step_x (camera coordinates,
 // i < kBlockSide); fused_pixel[i] gets the pixel voxel i took its observation from, -1 where it
@@ -124,11 +109,8 @@ template <auto depth_at>
   const Floats inverse_z = 1.0f / z;
   const Floats u = k.fx * x * inverse_z + k.cx, v = k.fy * y * inverse_z + k.cy;
   // nearest_pixel() for every lane; outside lanes read pixel 0 and are masked off.
-  const Ints inside = (z > 0) & (u >= -0.5f) & (v >= -0.5f) & (u < float(k.width) - 0.5f) &
-                      (v < float(k.height) - 0.5f);
-  const Ints column = __builtin_convertvector(inside ? u + 0.5f : Floats{}, Ints);
-  const Ints row = __builtin_convertvector(inside ? v + 0.5f : Floats{}, Ints);
-  const Ints pixel = row * k.width + column;
+  Ints inside = z > 0, pixel;
+  nearest_pixels(u, v, k.width, k.height, inside, pixel);
   Floats d;
   depth_at(k.depth, pixel, d);
   Floats sdf, w;
@@ -182,15 +164,15 @@ using BlockKernel = void (*)(const FrameConstants&, const float[3], float*, floa
                                                float* sdf_m, float* weight,
                                                std::int32_t* fused_pixel, const float* next_sdf_m,
                                                const float* next_weight) {
-  integrate_block<depth_lane_by_lane>(k, origin, sdf_m, weight, fused_pixel, next_sdf_m,
-                                      next_weight);
+  integrate_block<gather_lane_by_lane>(k, origin, sdf_m, weight, fused_pixel, next_sdf_m,
+                                       next_weight);
 }
 
 #if defined(__x86_64__)
 [[gnu::target("arch=x86-64-v3"), gnu::flatten]] void integrate_block_x86_64_v3(
     const FrameConstants& k, const float origin[3], float* sdf_m, float* weight,
     std::int32_t* fused_pixel, const float* next_sdf_m, const float* next_weight) {
-  integrate_block<depth_gathered>(k, origin, sdf_m, weight, fused_pixel, next_sdf_m, next_weight);
+  integrate_block<gather_avx2>(k, origin, sdf_m, weight, fused_pixel, next_sdf_m, next_weight);
 }
 #endif
 

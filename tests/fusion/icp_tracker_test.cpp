@@ -34,52 +34,51 @@ class IcpTracker : public ::testing::Test {
   const Intrinsics camera_{80, 60, 70.0, 70.0, 39.5, 29.5};
 };
 
-TEST_F(IcpTracker, RecoversAKnownRigidMotion) {
-  const Pose reference = Pose::Identity();
+// A camera moved by `angle` about `axis` and by `translation` from the reference (identity).
+Pose moved_pose(double angle, const Eigen::Vector3d& axis, const Eigen::Vector3d& translation) {
   Pose moved = Pose::Identity();
-  moved.linear() =
-      Eigen::AngleAxisd(0.03, Eigen::Vector3d(0.3, 1, 0.2).normalized()).toRotationMatrix();
-  moved.translation() = Eigen::Vector3d(0.02, -0.015, 0.03);
-
-  const SurfaceView model = raycast(volume_, camera_, reference);
-  const SurfaceView frame = raycast(volume_, camera_, moved);
-  const TrackingResult result =
-      track_frame(frame.depth_m, camera_, model, camera_, reference, reference);
-  ASSERT_EQ(result.status, TrackingStatus::tracked);
-  const Pose error = result.camera_to_world.inverse() * moved;
-  EXPECT_LT(error.translation().norm(), 0.002);
-  EXPECT_LT(Eigen::AngleAxisd(error.rotation()).angle(), 0.002);
-  EXPECT_LT(result.rmse_m, 0.005);
-}
-
-// A moved camera whose frame is 83 x 61 pixels: the association's 8-pixel groups end in partial
-// ones.
-Pose moved_pose() {
-  Pose moved = Pose::Identity();
-  moved.linear() =
-      Eigen::AngleAxisd(0.02, Eigen::Vector3d(-0.5, 1, 0.3).normalized()).toRotationMatrix();
-  moved.translation() = Eigen::Vector3d(-0.015, 0.01, 0.02);
+  moved.linear() = Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
+  moved.translation() = translation;
   return moved;
 }
+
+// Tracks the frame seen from `moved` (with `camera`) against the model ray cast from the
+// reference (with `model_camera`) and checks the estimate is within `tolerance` (metres and
+// radians) of `moved`.
+TrackingResult expect_recovered(const TsdfVolume& volume, const Intrinsics& camera,
+                                const Intrinsics& model_camera, const Pose& moved,
+                                double tolerance) {
+  const Pose reference = Pose::Identity();
+  const SurfaceView model = raycast(volume, model_camera, reference);
+  const SurfaceView frame = raycast(volume, camera, moved);
+  const TrackingResult result =
+      track_frame(frame.depth_m, camera, model, model_camera, reference, reference);
+  EXPECT_EQ(result.status, TrackingStatus::tracked);
+  const Pose error = result.camera_to_world.inverse() * moved;
+  EXPECT_LT(error.translation().norm(), tolerance);
+  EXPECT_LT(Eigen::AngleAxisd(error.rotation()).angle(), tolerance);
+  return result;
+}
+
+TEST_F(IcpTracker, RecoversAKnownRigidMotion) {
+  const Pose moved =
+      moved_pose(0.03, Eigen::Vector3d(0.3, 1, 0.2), Eigen::Vector3d(0.02, -0.015, 0.03));
+  EXPECT_LT(expect_recovered(volume_, camera_, camera_, moved, 0.002).rmse_m, 0.005);
+}
+
+// A frame of 83 x 61 pixels: the association's 8-pixel groups end in partial ones.
 const Intrinsics kOddCamera{83, 61, 72.0, 72.0, 41.0, 30.0};
+const Pose kOddMove =
+    moved_pose(0.02, Eigen::Vector3d(-0.5, 1, 0.3), Eigen::Vector3d(-0.015, 0.01, 0.02));
 
 TEST_F(IcpTracker, RecoversTheMotionAgainstAHalfResolutionModel) {
-  const Pose reference = Pose::Identity(), moved = moved_pose();
-  const Intrinsics half = kOddCamera.scaled(0.5);
-  const SurfaceView model = raycast(volume_, half, reference);
-  const SurfaceView frame = raycast(volume_, kOddCamera, moved);
-  const TrackingResult result =
-      track_frame(frame.depth_m, kOddCamera, model, half, reference, reference);
-  ASSERT_EQ(result.status, TrackingStatus::tracked);
-  const Pose error = result.camera_to_world.inverse() * moved;
-  EXPECT_LT(error.translation().norm(), 0.003);
-  EXPECT_LT(Eigen::AngleAxisd(error.rotation()).angle(), 0.003);
+  expect_recovered(volume_, kOddCamera, kOddCamera.scaled(0.5), kOddMove, 0.003);
 }
 
 TEST_F(IcpTracker, TheEstimateDoesNotDependOnTheNumberOfThreads) {
-  const Pose reference = Pose::Identity(), moved = moved_pose();
+  const Pose reference = Pose::Identity();
   const SurfaceView model = raycast(volume_, kOddCamera, reference);
-  const SurfaceView frame = raycast(volume_, kOddCamera, moved);
+  const SurfaceView frame = raycast(volume_, kOddCamera, kOddMove);
   const auto track = [&] {
     return track_frame(frame.depth_m, kOddCamera, model, kOddCamera, reference, reference);
   };
