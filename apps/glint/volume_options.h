@@ -1,5 +1,6 @@
 #pragma once
-// The TSDF volume's command-line options, shared by `glint fuse` and `glint reconstruct`.
+// The geometry's command-line options (TSDF volume, tracking, integration device), shared by
+// `glint fuse` and `glint reconstruct`.
 #include <CLI/CLI.hpp>
 
 #include "fusion/fusion_pipeline.h"

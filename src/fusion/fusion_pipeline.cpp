@@ -1,6 +1,7 @@
 #include "fusion/fusion_pipeline.h"
 
 #include <cmath>
+#include <string>
 
 #include "core/error.h"
 
@@ -8,6 +9,9 @@ namespace glint::fusion {
 
 FusionPipeline::FusionPipeline(const Intrinsics& intrinsics, const FusionParams& params)
     : intrinsics_(intrinsics), params_(params), volume_(params.volume) {
+  if (params.tracking.model_halvings < 0 || params.tracking.model_halvings > 4)
+    throw Error("tracking", "model_halvings",
+                "must be in 0..4, got " + std::to_string(params.tracking.model_halvings));
   if (params.device == IntegrationDevice::cuda ||
       (params.device == IntegrationDevice::automatic && CudaIntegrator::available()))
     gpu_ = std::make_unique<CudaIntegrator>(volume_);

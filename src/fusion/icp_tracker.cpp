@@ -74,8 +74,8 @@ struct Association {
 // dependent double additions per pair were most of a tracked frame's association time.
 constexpr int kLanes = kLaneCount;
 
-// Lane-wise sums of a range's pairs, in float: a range holds at most a few thousand pixels, a few
-// hundred per lane.
+// Lane-wise sums of a range's pairs, in float: a range holds at most 1024 pixels (the reduction's
+// grain), 128 per lane; the ranges' sums are then added in double.
 struct LaneSums {
   Floats lhs[21], rhs[6], squared_error;
   Ints count;
@@ -217,9 +217,9 @@ NormalEquations associate(const PyramidLevel& level, const SurfaceView& model,
   a.model_height = model_intrinsics.height;
   a.max_squared_distance = float(params.max_distance_m * params.max_distance_m);
   a.cos_max_angle = float(std::cos(params.max_normal_angle_deg * std::numbers::pi / 180));
+  static const RangeKernel associate_range = range_kernel();
   // Deterministic splits and joins: the float lane sums round differently in other ranges, and a
   // tracked run's poses should not depend on the scheduling.
-  static const RangeKernel associate_range = range_kernel();
   return tbb::parallel_deterministic_reduce(
       tbb::blocked_range<std::size_t>(0, level.points.pixel_count(), 1024), NormalEquations{},
       [&](const tbb::blocked_range<std::size_t>& range, NormalEquations sum) {

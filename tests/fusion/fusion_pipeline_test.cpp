@@ -1,6 +1,6 @@
 // The pipeline on the tiny reader fixture (tests/data/rgbd/glint: a wall 1.0-1.15 m in front
-// of a 16x12 camera): ground-truth poses give a wall mesh; tracking and a too-small block pool
-// are handled without a crash.
+// of a 16x12 camera): ground-truth poses give a wall mesh; tracking (also against a
+// half-resolution model), a too-small block pool and bad parameters are handled without a crash.
 #include "fusion/fusion_pipeline.h"
 
 #include <gtest/gtest.h>
@@ -101,6 +101,23 @@ TEST(FusionPipeline, ExhaustedPoolAndMissingGroundTruthAreErrors) {
   io::RgbdFrame frame = io::read_rgbd_frame(sequence, 0);
   frame.ground_truth.reset();
   EXPECT_THROW(pipeline.process(frame), Error);
+
+  params = small_params(false);
+  params.tracking.model_halvings = 5;
+  EXPECT_THROW(FusionPipeline(sequence.intrinsics, params), Error);
+}
+
+// Tracking against a model ray cast at half the frame's resolution.
+TEST(FusionPipeline, TracksAgainstAHalfResolutionModel) {
+  const io::RgbdSequence sequence = fixture();
+  FusionParams params = small_params(false);
+  params.tracking.model_halvings = 1;
+  FusionPipeline pipeline(sequence.intrinsics, params);
+  for (std::size_t i = 0; i < sequence.frames.size(); ++i) {
+    const FrameResult result = pipeline.process(io::read_rgbd_frame(sequence, i));
+    EXPECT_TRUE(result.integrated);
+    EXPECT_TRUE(result.camera_to_world.matrix().allFinite());
+  }
 }
 
 }  // namespace
