@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "fusion/depth_maps.h"
 
 namespace glint::fusion {
 
@@ -24,7 +25,11 @@ Pose FusionPipeline::predict_pose() const {
 }
 
 Intrinsics FusionPipeline::model_intrinsics() const {
-  return intrinsics_.scaled(std::ldexp(1.0, -params_.tracking.model_halvings));
+  Intrinsics model = intrinsics_.scaled(std::ldexp(1.0, -params_.tracking.model_halvings));
+  // The size of the depth halved as often (downsample_depth() drops an odd last row / column).
+  model.width = intrinsics_.width >> params_.tracking.model_halvings;
+  model.height = intrinsics_.height >> params_.tracking.model_halvings;
+  return model;
 }
 
 FrameResult FusionPipeline::process(const io::RgbdFrame& frame) {
@@ -66,7 +71,14 @@ FrameResult FusionPipeline::process(const io::RgbdFrame& frame) {
   }
   if (!params_.use_ground_truth_poses) {
     Stopwatch watch;
-    model_ = raycast(volume_, model_intrinsics(), result.camera_to_world);
+    // The frame was just fused from this pose: its depth tells each ray where the surface is.
+    ImageF halved;
+    for (int level = 0; level < params_.tracking.model_halvings; ++level)
+      halved = downsample_depth(level == 0 ? frame.depth_m : halved,
+                                params_.tracking.bilateral.sigma_depth_m);
+    model_ =
+        raycast(volume_, model_intrinsics(), result.camera_to_world, RaycastNormals::from_points,
+                params_.tracking.model_halvings == 0 ? &frame.depth_m : &halved);
     timings_.add("raycast", watch.elapsed_ms());
   }
   return result;

@@ -26,8 +26,14 @@ struct SurfaceView {
 // product is no normal of either: there the TSDF's gradient at the hit (renderings use this).
 enum class RaycastNormals { from_points, from_gradient };
 
+// `depth_hint`, when given, is the depth image (same size; 0 = none) of the frame just fused from
+// this very pose: a ray whose pixel has depth d looks for the front face within a few voxels of
+// d first (a few trilinear reads instead of the march from its tile's start), and marches only
+// where it finds none. Surfaces in front of d that the frame saw through (stale ones) are then
+// not found. Throws glint::Error when its size differs from the view's.
 SurfaceView raycast(const TsdfVolume& volume, const Intrinsics& intrinsics,
                     const Pose& camera_to_world,
-                    RaycastNormals normals = RaycastNormals::from_points);
+                    RaycastNormals normals = RaycastNormals::from_points,
+                    const ImageF* depth_hint = nullptr);
 
 }  // namespace glint::fusion

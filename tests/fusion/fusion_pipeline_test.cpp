@@ -107,7 +107,8 @@ TEST(FusionPipeline, ExhaustedPoolAndMissingGroundTruthAreErrors) {
   EXPECT_THROW(FusionPipeline(sequence.intrinsics, params), Error);
 }
 
-// Tracking against a model ray cast at half the frame's resolution.
+// Tracking against a model ray cast at half the frame's resolution (the fixture's wall alone
+// leaves three degrees of freedom open, so only the run itself is checked, as above).
 TEST(FusionPipeline, TracksAgainstAHalfResolutionModel) {
   const io::RgbdSequence sequence = fixture();
   FusionParams params = small_params(false);
@@ -115,9 +116,10 @@ TEST(FusionPipeline, TracksAgainstAHalfResolutionModel) {
   FusionPipeline pipeline(sequence.intrinsics, params);
   for (std::size_t i = 0; i < sequence.frames.size(); ++i) {
     const FrameResult result = pipeline.process(io::read_rgbd_frame(sequence, i));
-    EXPECT_TRUE(result.integrated);
+    EXPECT_EQ(result.tracking.has_value(), i > 0);
     EXPECT_TRUE(result.camera_to_world.matrix().allFinite());
   }
+  EXPECT_EQ(pipeline.timings().to_json()["raycast"]["count"], 3);
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
-// Ray casting an analytic TSDF: depth, normals and colour of a sphere seen head-on, and the
-// normals at its silhouette against a wall.
+// Ray casting an analytic TSDF: depth, normals and colour of a sphere seen head-on, the same
+// found from a depth hint, and the normals at its silhouette against a wall.
 #include "fusion/raycast.h"
 
 #include <gtest/gtest.h>
@@ -10,6 +10,7 @@
 #include <memory>
 #include <utility>
 
+#include "core/error.h"
 #include "fusion_test_support.h"
 
 namespace glint::fusion {
@@ -62,6 +63,61 @@ TEST(Raycast, SphereDepthAndNormalsMatchTheAnalyticSurface) {
   }
   EXPECT_GT(hits, 200);
   EXPECT_EQ(view.depth_m.at(0, 0, 0), 0.0f);  // the corner ray misses
+}
+
+// First intersection depth of pixel (x, y)'s ray with the sphere, or 0 where it misses or grazes.
+double sphere_depth(int x, int y) {
+  const Eigen::Vector3d ray = kCamera.ray(x, y);
+  const double a = ray.squaredNorm(), b = -2 * ray.dot(kCentre),
+               c = kCentre.squaredNorm() - kRadius * kRadius;
+  const double discriminant = b * b - 4 * a * c;
+  return discriminant < 0.05 ? 0 : (-b - std::sqrt(discriminant)) / (2 * a);
+}
+
+// A depth hint (the frame just fused from this pose) 5 mm off the surface: the rays find it from
+// a few reads near the hint; pixels without a hint march as before.
+TEST(Raycast, ADepthHintFindsTheSurfaceNearIt) {
+  const auto volume = analytic_volume(sphere, 1.4);
+  const SurfaceView marched = raycast(*volume, kCamera, Pose::Identity());
+  ImageF hint = marched.depth_m;
+  for (int y = 0; y < kCamera.height; ++y)
+    for (int x = 0; x < kCamera.width; ++x) {
+      float& d = hint.at(x, y, 0);
+      d = (x + 3 * y) % 7 == 0 || !(d > 0) ? 0.0f : d + 0.005f * float((x + y) % 3 - 1);
+    }
+  const SurfaceView hinted =
+      raycast(*volume, kCamera, Pose::Identity(), RaycastNormals::from_points, &hint);
+  int hinted_hits = 0;
+  for (int y = 0; y < kCamera.height; ++y)
+    for (int x = 0; x < kCamera.width; ++x) {
+      const float depth = hinted.depth_m.at(x, y, 0);
+      if (!(hint.at(x, y, 0) > 0)) {
+        EXPECT_EQ(depth, marched.depth_m.at(x, y, 0)) << x << "," << y;
+        continue;
+      }
+      if (sphere_depth(x, y) == 0) continue;
+      EXPECT_NEAR(depth, sphere_depth(x, y), 0.002) << x << "," << y;
+      ++hinted_hits;
+    }
+  EXPECT_GT(hinted_hits, 150);
+}
+
+// A hint behind a surface (one the frame saw through, e.g. an object since moved away) finds the
+// hinted surface, not the first along the ray; a hint of another size is an error.
+TEST(Raycast, ADepthHintBehindASurfaceFindsTheHintedOne) {
+  constexpr double kWall = 1.6;
+  const auto volume = analytic_volume(
+      [](const Eigen::Vector3d& p) { return std::min(sphere(p), kWall - p.z()); }, 1.8);
+  const int x = kCamera.width / 2, y = kCamera.height / 2;
+  ImageF hint(kCamera.width, kCamera.height, 1);
+  hint.at(x, y, 0) = float(kWall);
+  const SurfaceView view =
+      raycast(*volume, kCamera, Pose::Identity(), RaycastNormals::from_points, &hint);
+  EXPECT_NEAR(view.depth_m.at(x, y, 0), kWall, 0.002);
+  EXPECT_NEAR(view.depth_m.at(x + 1, y, 0), sphere_depth(x + 1, y), 0.002);  // no hint there
+  const ImageF wrong(kCamera.width / 2, kCamera.height, 1);
+  EXPECT_THROW(raycast(*volume, kCamera, Pose::Identity(), RaycastNormals::from_points, &wrong),
+               Error);
 }
 
 TEST(Raycast, RaysCrossMetresOfEmptySpaceToAFarWall) {
