@@ -4,7 +4,6 @@
 
 #include <atomic>
 #include <bit>
-#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -132,29 +131,6 @@ float march(TsdfSampler& sampler, const Eigen::Vector3f& origin, const Eigen::Ve
   return 0;
 }
 
-// The front face's crossing near depth `hint` along origin + t * ray (ray z = 1), from trilinear
-// values, or 0 when a value there is not observed or no + to - pair brackets it within
-// kHintSteps steps. For a ray of the camera that has just fused a frame, sdf is that frame's
-// depth minus the point's, so t + sdf is the crossing: each step goes there and a quarter voxel
-// beyond, so that the next value brackets it, and the crossing is interpolated between the pair.
-float crossing_near(TsdfSampler& sampler, const Eigen::Vector3f& origin, const Eigen::Vector3f& ray,
-                    float hint, float voxel) {
-  constexpr int kHintSteps = 4;
-  float t = hint, sdf;
-  if (!sampler.trilinear(origin + ray * t, sdf)) return 0;
-  for (int step = 0; step < kHintSteps; ++step) {
-    const float next_t = t + sdf + std::copysign(0.25f * voxel, sdf);
-    float next_sdf;
-    if (!(next_t > 0) || !sampler.trilinear(origin + ray * next_t, next_sdf)) return 0;
-    // A front face: positive before the crossing, negative beyond.
-    if (sdf > 0 && next_sdf < 0) return t + (next_t - t) * sdf / (sdf - next_sdf);
-    if (sdf < 0 && next_sdf > 0) return next_t + (t - next_t) * next_sdf / (next_sdf - sdf);
-    t = next_t;
-    sdf = next_sdf;
-  }
-  return 0;
-}
-
 // Whether the central differences of normals_from_points() at (x, y) straddle a depth edge:
 // a neighbour without a hit, or a second difference of depth above 1 % of it (a plane's depth
 // has almost none; a silhouette's jumps by the gap between the surfaces).
@@ -195,8 +171,12 @@ SurfaceView raycast(const TsdfVolume& volume, const Intrinsics& intrinsics,
       ranges.interval(x, y, near, far);
       if (near > far) continue;
       const Eigen::Vector3f ray = rotation * intrinsics.ray(x, y).cast<float>();
+      // With a hint d, first from the truncation band's front edge d - t(d): in front of the
+      // surface the frame just fused, inside the space its voxels cover.
       const float hint = depth_hint ? depth_hint->at(x, y, 0) : 0.0f;
-      float t = hint > 0 ? crossing_near(sampler, origin, ray, hint, voxel) : 0.0f;
+      const float start = hint - float(params.truncation_at(hint));
+      float t =
+          hint > 0 && start > near ? march(sampler, origin, ray, start, far, voxel, block) : 0;
       if (!(t > 0)) t = march(sampler, origin, ray, near, far, voxel, block);
       if (t <= 0) continue;
       const Eigen::Vector3f p = origin + ray * t;

@@ -6,8 +6,8 @@
 // through unallocated space, one voxel through unobserved voxels, 0.8 * |sdf| (at least one
 // voxel) through observed ones, reading trilinear values within 2 voxels of the surface; the
 // first + to - crossing is located by linear interpolation between the two samples around it.
-// Back faces (- first) end the ray without a hit. With a depth hint (below), a ray first looks
-// for the crossing near the hinted depth.
+// Back faces (- first) end the ray without a hit. With a depth hint (below), a ray first marches
+// from just in front of the hinted depth.
 #include "core/camera.h"
 #include "core/image.h"
 #include "fusion/tsdf_volume.h"
@@ -28,10 +28,11 @@ struct SurfaceView {
 enum class RaycastNormals { from_points, from_gradient };
 
 // `depth_hint`, when given, is the depth image (same size; 0 = none) of the frame just fused from
-// this very pose: a ray whose pixel has depth d looks for the front face within a few voxels of
-// d first (a few trilinear reads instead of the march from its tile's start), and marches only
-// where it finds none. Surfaces in front of d that the frame saw through (stale ones) are then
-// not found. Throws glint::Error when its size differs from the view's.
+// this very pose: a ray whose pixel has depth d marches from d - truncation_at(d) first (the
+// band's front edge, free space in front of the surface the frame fused) and from its tile's
+// start only where that finds no surface. A surface in front of that start which the frame saw
+// through (a stale one) is then not found. Throws glint::Error when its size differs from the
+// view's.
 SurfaceView raycast(const TsdfVolume& volume, const Intrinsics& intrinsics,
                     const Pose& camera_to_world,
                     RaycastNormals normals = RaycastNormals::from_points,

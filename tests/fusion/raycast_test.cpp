@@ -74,8 +74,8 @@ double sphere_depth(int x, int y) {
   return discriminant < 0.05 ? 0 : (-b - std::sqrt(discriminant)) / (2 * a);
 }
 
-// A depth hint (the frame just fused from this pose) 5 mm off the surface: the rays find it from
-// a few reads near the hint; pixels without a hint march as before.
+// A depth hint (the frame just fused from this pose) 5 mm off the surface: the rays march from
+// just in front of it and find the sphere; pixels without a hint march as before.
 TEST(Raycast, ADepthHintFindsTheSurfaceNearIt) {
   const auto volume = analytic_volume(sphere, 1.4);
   const SurfaceView marched = raycast(*volume, kCamera, Pose::Identity());
@@ -102,8 +102,9 @@ TEST(Raycast, ADepthHintFindsTheSurfaceNearIt) {
   EXPECT_GT(hinted_hits, 150);
 }
 
-// A hint behind a surface (one the frame saw through, e.g. an object since moved away) finds the
-// hinted surface, not the first along the ray; a hint of another size is an error.
+// A hint behind a surface (one the frame saw through, e.g. an object since moved away): the ray
+// marches from in front of the hinted surface and finds it, not the first along the ray; a hint
+// of another size is an error.
 TEST(Raycast, ADepthHintBehindASurfaceFindsTheHintedOne) {
   constexpr double kWall = 1.6;
   const auto volume = analytic_volume(
