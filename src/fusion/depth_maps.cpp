@@ -50,6 +50,11 @@ ImageF bilateral_filter_depth(const ImageF& depth_m, const BilateralParams& para
   const float space = static_cast<float>(-0.5 / (params.sigma_space_px * params.sigma_space_px));
   const float range = static_cast<float>(-0.5 / (params.sigma_depth_m * params.sigma_depth_m));
   const float max_difference = std::sqrt(-100.0f / range);
+  std::vector<float> spatial((2 * radius + 1) * (2 * radius + 1));
+  for (int dy = -radius; dy <= radius; ++dy)
+    for (int dx = -radius; dx <= radius; ++dx)
+      spatial[(dy + radius) * (2 * radius + 1) + dx + radius] =
+          std::exp(space * float(dx * dx + dy * dy));
   ImageF filtered(width, height, 1);
   const float* in = depth_m.plane(0);
   float* out = filtered.plane(0);
@@ -64,7 +69,7 @@ ImageF bilateral_filter_depth(const ImageF& depth_m, const BilateralParams& para
             for (int dx = -radius; dx <= radius; ++dx)
               add_bilateral_offset(centre, centre + std::ptrdiff_t(dy) * width, dx,
                                    std::max(0, -dx), std::min(width, width - dx),
-                                   std::exp(space * float(dx * dx + dy * dy)), range,
+                                   spatial[(dy + radius) * (2 * radius + 1) + dx + radius], range,
                                    max_difference, sum.data(), weights.data());
           // A pixel with depth weighs itself in, so its weights are positive.
           for (int x = 0; x < width; ++x)
@@ -97,6 +102,13 @@ ImageF downsample_depth(const ImageF& depth_m, double sigma_depth_m) {
     }
   });
   return half;
+}
+
+const ImageF& halved_depth(const ImageF& depth_m, int halvings, double sigma_depth_m,
+                           ImageF& storage) {
+  for (int level = 0; level < halvings; ++level)
+    storage = downsample_depth(level == 0 ? depth_m : storage, sigma_depth_m);
+  return halvings == 0 ? depth_m : storage;
 }
 
 ImageF points_from_depth(const ImageF& depth_m, const Intrinsics& intrinsics) {

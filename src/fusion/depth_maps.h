@@ -22,6 +22,11 @@ ImageF bilateral_filter_depth(const ImageF& depth_m, const BilateralParams& para
 // block's first valid depth (KinectFusion's block average that does not smooth across edges).
 ImageF downsample_depth(const ImageF& depth_m, double sigma_depth_m);
 
+// depth_m downsampled `halvings` times (downsample_depth()): depth_m itself for 0, else the
+// result, kept in `storage`.
+const ImageF& halved_depth(const ImageF& depth_m, int halvings, double sigma_depth_m,
+                           ImageF& storage);
+
 // Camera-space points of a depth map.
 ImageF points_from_depth(const ImageF& depth_m, const Intrinsics& intrinsics);
 

@@ -73,12 +73,10 @@ FrameResult FusionPipeline::process(const io::RgbdFrame& frame) {
     Stopwatch watch;
     // The frame was just fused from this pose: its depth tells each ray where the surface is.
     ImageF halved;
-    for (int level = 0; level < params_.tracking.model_halvings; ++level)
-      halved = downsample_depth(level == 0 ? frame.depth_m : halved,
-                                params_.tracking.bilateral.sigma_depth_m);
-    model_ =
-        raycast(volume_, model_intrinsics(), result.camera_to_world, RaycastNormals::from_points,
-                params_.tracking.model_halvings == 0 ? &frame.depth_m : &halved);
+    const ImageF& hint = halved_depth(frame.depth_m, params_.tracking.model_halvings,
+                                      params_.tracking.bilateral.sigma_depth_m, halved);
+    model_ = raycast(volume_, model_intrinsics(), result.camera_to_world,
+                     RaycastNormals::from_points, &hint);
     timings_.add("raycast", watch.elapsed_ms());
   }
   return result;

@@ -70,9 +70,9 @@ struct Association {
   float max_squared_distance, cos_max_angle;
 };
 
-// Eight pixels at a time in vector lanes (vector_lanes.h): pixel by pixel, the sums' 27
-// dependent double additions per pair were most of a tracked frame's association time.
-constexpr int kLanes = kLaneCount;
+// The association runs eight pixels at a time in vector lanes (vector_lanes.h): pixel by pixel,
+// the sums' 27 dependent double additions per pair were most of a tracked frame's association
+// time.
 
 // Lane-wise sums of a range's pairs, in float: a range holds at most 1024 pixels (the reduction's
 // grain), 128 per lane; the ranges' sums are then added in double.
@@ -86,18 +86,18 @@ struct LaneSums {
   mask &= (x - x) == 0;
 }
 
-// Pixels [i, i + kLanes) of `plane`; lanes at or beyond `end` read NaN (no point).
+// Pixels [i, i + kLaneCount) of `plane`; lanes at or beyond `end` read NaN (no point).
 [[gnu::always_inline]] inline void load_lanes(const float* plane, std::size_t i, std::size_t end,
                                               Floats& out) {
-  if (i + kLanes <= end) {
+  if (i + kLaneCount <= end) {
     std::memcpy(&out, plane + i, sizeof(out));
     return;
   }
-  for (int lane = 0; lane < kLanes; ++lane)
+  for (int lane = 0; lane < kLaneCount; ++lane)
     out[lane] = i + lane < end ? plane[i + lane] : std::numeric_limits<float>::quiet_NaN();
 }
 
-// Adds pixels [i, i + kLanes) (those before `end`): each frame point is moved into the world by
+// Adds pixels [i, i + kLaneCount) (those before `end`): each frame point is moved into the world by
 // the estimate, projected into the model view and paired with the model point at the nearest
 // pixel; pairs farther apart than the limit or with normals too far apart are left out.
 template <auto gather>
@@ -159,8 +159,8 @@ template <auto gather>
 [[gnu::always_inline]] inline void sum_range(const Association& a, std::size_t begin,
                                              std::size_t end, NormalEquations& out) {
   LaneSums sums{};
-  for (std::size_t i = begin; i < end; i += kLanes) associate_lanes<gather>(a, i, end, sums);
-  for (int lane = 0; lane < kLanes; ++lane) {
+  for (std::size_t i = begin; i < end; i += kLaneCount) associate_lanes<gather>(a, i, end, sums);
+  for (int lane = 0; lane < kLaneCount; ++lane) {
     int entry = 0;
     for (int r = 0; r < 6; ++r) {
       for (int c = r; c < 6; ++c) out.lhs(r, c) += double(sums.lhs[entry++][lane]);

@@ -103,7 +103,6 @@ template <auto depth_at>
 [[gnu::always_inline]] inline void integrate_row(const FrameConstants& k, const float first[3],
                                                  float* sdf_m, float* weight,
                                                  std::int32_t* fused_pixel) {
-  static_assert(kBlockSide == 8);
   const Floats x = first[0] + kLanes * k.step_x[0], y = first[1] + kLanes * k.step_x[1],
                z = first[2] + kLanes * k.step_x[2];
   const Floats inverse_z = 1.0f / z;

@@ -115,13 +115,10 @@ void ReflectancePipeline::refine_albedo_of_visible() {
 const Image<std::int32_t>& ReflectancePipeline::segment_frame(const ImageF& depth_m) {
   const int shift = params_.segmentation_halvings;
   ImageF halved;
+  const ImageF& depth = fusion::halved_depth(
+      depth_m, shift, params_.geometry.tracking.bilateral.sigma_depth_m, halved);
   Intrinsics intrinsics = intrinsics_;
-  for (int level = 0; level < shift; ++level) {
-    halved = fusion::downsample_depth(level == 0 ? depth_m : halved,
-                                      params_.geometry.tracking.bilateral.sigma_depth_m);
-    intrinsics = intrinsics.scaled(0.5);
-  }
-  const ImageF& depth = shift == 0 ? depth_m : halved;
+  for (int level = 0; level < shift; ++level) intrinsics = intrinsics.scaled(0.5);
   const Image<std::int32_t>& coarse = depth_segmenter_.segment(depth, intrinsics).labels;
   if (shift == 0) return coarse;
   // Every full-resolution pixel takes the label of the coarse pixel covering it.
