@@ -33,11 +33,12 @@ class TsdfSampler {
   bool trilinear(const Eigen::Vector3f& p, float& sdf_m) {
     const Eigen::Vector3f v = p * inverse_voxel_;
     const int x = int(std::floor(v.x())), y = int(std::floor(v.y())), z = int(std::floor(v.z()));
+    float cell[2][2][2];
+    if (!read_box(
+            x, y, z, [](int, int, int) { return true; }, cell))
+      return false;
     float corner[8];
-    for (int c = 0; c < 8; ++c) {
-      if (voxel(x + (c & 1), y + ((c >> 1) & 1), z + ((c >> 2) & 1), corner[c]) != Sample::observed)
-        return false;
-    }
+    for (int c = 0; c < 8; ++c) corner[c] = cell[c & 1][(c >> 1) & 1][(c >> 2) & 1];
     sdf_m = interpolate(corner, v.x() - x, v.y() - y, v.z() - z);
     return true;
   }
@@ -51,14 +52,10 @@ class TsdfSampler {
     // stencil[a][b][c] = voxel (x + a - 1, y + b - 1, z + c - 1): the 2x2x2 cell around p
     // (indices 1, 2) and its six face neighbours (one index 0 or 3).
     float stencil[4][4][4];
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        for (int c = 0; c < 4; ++c) {
-          const int outside = (a == 0 || a == 3) + (b == 0 || b == 3) + (c == 0 || c == 3);
-          if (outside > 1) continue;
-          if (voxel(x + a - 1, y + b - 1, z + c - 1, stencil[a][b][c]) != Sample::observed)
-            return false;
-        }
+    const auto in_stencil = [](int a, int b, int c) {
+      return (a == 0 || a == 3) + (b == 0 || b == 3) + (c == 0 || c == 3) <= 1;
+    };
+    if (!read_box(x - 1, y - 1, z - 1, in_stencil, stencil)) return false;
     const float fx = v.x() - x, fy = v.y() - y, fz = v.z() - z;
     const auto at = [&](int dx, int dy, int dz) {
       float corner[8];
@@ -106,6 +103,45 @@ class TsdfSampler {
                 lerp(lerp(corner[4], corner[5], fx), lerp(corner[6], corner[7], fx), fy), fz);
   }
   static int round_to_int(float value) { return static_cast<int>(std::floor(value + 0.5f)); }
+
+  // Reads voxel (x0 + a, y0 + b, z0 + c) into box[a][b][c] for each (a, b, c) that wanted()
+  // names; false when one of them is unallocated or unobserved. A box of at most a block's side
+  // spans at most two blocks along each axis: their (at most 8) look-ups are made once, and each
+  // voxel is then read at its offset in its block (per voxel, a cache look-up was most of the
+  // cost of the ray cast's and the surface refreshes' reads).
+  template <int kSpan, class Wanted>
+  bool read_box(int x0, int y0, int z0, Wanted wanted, float (&box)[kSpan][kSpan][kSpan]) {
+    static_assert(kSpan <= kBlockSide);
+    constexpr int last = kBlockSide - 1;
+    // Per axis and position: which of the two blocks (0, 1), and the voxel's offset in it.
+    int side_x[kSpan], side_y[kSpan], side_z[kSpan], offset_x[kSpan], offset_y[kSpan],
+        offset_z[kSpan];
+    for (int i = 0; i < kSpan; ++i) {
+      side_x[i] = ((x0 + i) >> 3) - (x0 >> 3);
+      side_y[i] = ((y0 + i) >> 3) - (y0 >> 3);
+      side_z[i] = ((z0 + i) >> 3) - (z0 >> 3);
+      offset_x[i] = (x0 + i) & last;
+      offset_y[i] = ((y0 + i) & last) * kBlockSide;
+      offset_z[i] = ((z0 + i) & last) * kBlockSide * kBlockSide;
+    }
+    const float* blocks[2][2][2];
+    for (int c = 0; c <= side_z[kSpan - 1]; ++c)
+      for (int b = 0; b <= side_y[kSpan - 1]; ++b)
+        for (int a = 0; a <= side_x[kSpan - 1]; ++a) {
+          const int block = cached_block((x0 >> 3) + a, (y0 >> 3) + b, (z0 >> 3) + c);
+          blocks[a][b][c] = block < 0 ? nullptr : volume_.sdf_m(block);
+        }
+    for (int a = 0; a < kSpan; ++a)
+      for (int b = 0; b < kSpan; ++b)
+        for (int c = 0; c < kSpan; ++c) {
+          if (!wanted(a, b, c)) continue;
+          const float* block = blocks[side_x[a]][side_y[b]][side_z[c]];
+          if (!block) return false;
+          box[a][b][c] = block[offset_z[c] + offset_y[b] + offset_x[a]];
+          if (!observed(box[a][b][c])) return false;
+        }
+    return true;
+  }
 
   // The pool index of block (bx, by, bz), or -1. A stencil of a few voxels spans at most two
   // blocks along each axis: a cache of two per axis holds all eight, where a single entry was

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <vector>
 
 #include "fusion_test_support.h"
@@ -34,6 +35,34 @@ TEST(TsdfSampler, GradientOfALinearFieldIsItsNormalAcrossBlockFaces) {
     EXPECT_NEAR(value, normal.cast<float>().dot(p) - 0.02f, 1e-5f);
     EXPECT_LT((gradient - normal.cast<float>()).norm(), 1e-4f) << gradient.transpose();
   }
+}
+
+TEST(TsdfSampler, ACellAcrossBlockCornersReadsEachVoxelFromItsBlock) {
+  const Eigen::Vector3d normal = Eigen::Vector3d(-0.6, 0.2, 0.7).normalized();
+  TsdfVolume volume(centimetre_voxels());
+  test::fill_analytic(
+      volume, [&](const Eigen::Vector3d& p) { return normal.dot(p) + 0.01; }, 0.5, 0.3);
+  TsdfSampler sampler(volume);
+  // Cells whose corners lie in 1, 2, 4 and 8 blocks (8 cm blocks, voxel centres at 1 cm steps).
+  for (const Eigen::Vector3f& p :
+       {Eigen::Vector3f(0.0321f, 0.0452f, 0.0213f), Eigen::Vector3f(0.0752f, 0.0421f, 0.0133f),
+        Eigen::Vector3f(0.0752f, -0.0047f, 0.0133f), Eigen::Vector3f(-0.0044f, 0.0761f, 0.0788f)}) {
+    float value = 0;
+    ASSERT_TRUE(sampler.trilinear(p, value)) << p.transpose();
+    EXPECT_NEAR(value, normal.cast<float>().dot(p) + 0.01f, 1e-5f) << p.transpose();
+  }
+  // A cell reaching into an unallocated block is not read.
+  TsdfVolume single(centimetre_voxels());
+  const int block = single.allocate({0, 0, 0});
+  ASSERT_GE(block, 0);
+  std::fill_n(single.sdf_m(block), kVoxelsPerBlock, 0.02f);
+  std::fill_n(single.weight(block), kVoxelsPerBlock, 1.0f);
+  TsdfSampler reader(single);
+  float value = 0;
+  EXPECT_TRUE(reader.trilinear(Eigen::Vector3f(0.0652f, 0.0421f, 0.0133f), value));
+  EXPECT_FLOAT_EQ(value, 0.02f);
+  EXPECT_FALSE(reader.trilinear(Eigen::Vector3f(0.0752f, 0.0421f, 0.0133f), value));
+  EXPECT_FALSE(reader.trilinear(Eigen::Vector3f(0.0652f, -0.0047f, 0.0133f), value));
 }
 
 TEST(TsdfSampler, GradientIsTheCentralDifferenceOfTrilinearReads) {
