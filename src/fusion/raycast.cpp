@@ -99,24 +99,50 @@ class TileDepthRanges {
   std::vector<std::atomic<std::uint32_t>> near_, far_;
 };
 
+// Voxels a ray skips per step through unobserved voxels of allocated blocks (space behind
+// surfaces, or beside them, that no frame saw). Landing on observed space after such a stride,
+// it steps back and crosses the stride again voxel by voxel, so only an observed stretch
+// shorter than the stride can be missed; the truncation band in front of any surface is at
+// least 4 voxels deep (2 cm, 5 mm voxels).
+constexpr int kUnobservedStride = 3;
+
 // Depth t (metres along the optical axis) of the first + to - crossing along origin + t * ray,
 // or 0 when there is none in [t_min, t_max]. ray has z = 1 in camera space.
 float march(TsdfSampler& sampler, const Eigen::Vector3f& origin, const Eigen::Vector3f& ray,
             float t_min, float t_max, float voxel, float block) {
   const float inverse_length = 1.0f / ray.norm();
+  const float voxel_step = voxel * inverse_length;
   float previous_t = 0, previous_sdf = 0;
   bool previous_observed = false;
+  // The start of the last stride through unobserved voxels, and where voxel steps end again
+  // after stepping back over it.
+  float stride_start = -1, fine_until = t_min;
   for (float t = t_min; t <= t_max;) {
     const Eigen::Vector3f p = origin + ray * t;
     float sdf;
     TsdfSampler::Sample sample = sampler.nearest(p, sdf);
+    if (sample != TsdfSampler::Sample::unallocated && stride_start >= 0) {
+      if (sample == TsdfSampler::Sample::observed) {
+        fine_until = t;
+        t = stride_start + voxel_step;
+        stride_start = -1;
+        continue;
+      }
+      stride_start = -1;
+    }
+    if (sample == TsdfSampler::Sample::unobserved && t >= fine_until) {
+      stride_start = t;
+      t += kUnobservedStride * voxel_step;
+      previous_observed = false;
+      continue;
+    }
     // Near the surface, the trilinear value (a voxel without all 8 neighbours observed counts
     // as unobserved).
     if (sample == TsdfSampler::Sample::observed && sdf < 2 * voxel && !sampler.trilinear(p, sdf))
       sample = TsdfSampler::Sample::unobserved;
     if (sample != TsdfSampler::Sample::observed) {
       previous_observed = false;
-      t += (sample == TsdfSampler::Sample::unallocated ? 0.5f * block : voxel) * inverse_length;
+      t += sample == TsdfSampler::Sample::unallocated ? 0.5f * block * inverse_length : voxel_step;
       continue;
     }
     if (sdf < 0) {

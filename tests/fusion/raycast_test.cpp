@@ -140,6 +140,27 @@ TEST(Raycast, RaysCrossMetresOfEmptySpaceToAFarWall) {
       ASSERT_NEAR(view.depth_m.at(x, y, 0), kWall, 0.002) << x << "," << y;
 }
 
+TEST(Raycast, RaysStrideThroughUnobservedVoxelsAndStepBackToTheSurface) {
+  // A wall 1.003 m away behind 48 cm of allocated blocks no frame observed, and of its band in
+  // front only the last 2.8 cm observed: shorter than a stride through unobserved voxels (3 cm),
+  // so strides land behind the wall and must step back to find it.
+  constexpr double kWall = 1.003;
+  const auto volume = analytic_volume([](const Eigen::Vector3d& p) { return kWall - p.z(); }, 1.2);
+  for (int z = 5; z <= 10; ++z)
+    for (int y = -4; y <= 3; ++y)
+      for (int x = -4; x <= 3; ++x) ASSERT_GE(volume->allocate({x, y, z}), 0);
+  for (std::size_t block = 0; block < volume->block_count(); ++block)
+    for (int v = 0; v < kVoxelsPerBlock; ++v)
+      if (observed(volume->sdf_m(int(block))[v]) && volume->sdf_m(int(block))[v] > 0.025f) {
+        volume->sdf_m(int(block))[v] = kUnobservedSdf;
+        volume->weight(int(block))[v] = 0;
+      }
+  const SurfaceView view = raycast(*volume, kCamera, Pose::Identity());
+  for (int y = 0; y < kCamera.height; ++y)
+    for (int x = 0; x < kCamera.width; ++x)
+      ASSERT_NEAR(view.depth_m.at(x, y, 0), kWall, 0.002) << x << "," << y;
+}
+
 TEST(Raycast, GradientNormalsHoldAtSilhouettes) {
   // The sphere in front of a wall: at its silhouette the neighbouring pixels lie on the wall, so
   // the points' cross product is no normal of either; the TSDF's gradient is the sphere's own.
