@@ -52,11 +52,13 @@ const char* normals_name(const reflectance::ObservationGridParams& params) {
 
 // The model re-rendered from `pose`: ray cast (with gradient normals at silhouettes), its normals
 // smoothed within `normal_radius_m` (0: not), and shaded with the pipeline's materials and lights.
+// `fused_depth`: the depth of the frame just fused from `pose`, if it was, which the ray cast
+// starts from (fusion::raycast's depth hint).
 reflectance::MaterialMaps render_model(const reflectance::ReflectancePipeline& pipeline,
                                        const Intrinsics& intrinsics, const Pose& pose,
-                                       float normal_radius_m) {
-  fusion::SurfaceView view =
-      fusion::raycast(pipeline.geometry(), intrinsics, pose, fusion::RaycastNormals::from_gradient);
+                                       float normal_radius_m, const ImageF* fused_depth = nullptr) {
+  fusion::SurfaceView view = fusion::raycast(pipeline.geometry(), intrinsics, pose,
+                                             fusion::RaycastNormals::from_gradient, fused_depth);
   if (normal_radius_m > 0)
     view.normals = fusion::smooth_normals(view.points_m, view.normals, view.depth_m, intrinsics,
                                           normal_radius_m);
@@ -179,7 +181,7 @@ void run_reconstruct(ReconstructOptions options) {
         watch.restart();
         const reflectance::MaterialMaps maps =
             render_model(pipeline, sequence.intrinsics, result.geometry.camera_to_world,
-                         options.render_normal_radius_m);
+                         options.render_normal_radius_m, &frame.depth_m);
         command_timings.add("render", watch.elapsed_ms());
         watch.restart();
         if (evaluate) evaluation.add_frame(int(i), maps, *truth, frame.colour);
