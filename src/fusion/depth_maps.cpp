@@ -4,11 +4,13 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <vector>
 
 #include "core/fast_exp.h"
 #include "core/parallel.h"
+#include "fusion/vector_lanes.h"
 
 namespace glint::fusion {
 namespace {
@@ -40,6 +42,119 @@ void add_bilateral_offset(const float* __restrict centre, const float* __restric
     const float w = std::bit_cast<float>(std::bit_cast<std::int32_t>(falloff) & has_depth);
     sum[x] += w * d;
     weights[x] += w;
+  }
+}
+
+// A point map and a normal map as six planes (x, y, z of each), where a pixel without a normal
+// has the zero normal, padded on both sides of each row by pixels without one: a run of lanes
+// then reads any neighbour up to kPad columns off the image.
+struct SurfacePlanes {
+  static constexpr int kPad = 16;
+
+  SurfacePlanes(const ImageF& points, const ImageF& normals)
+      : width(points.width()),
+        stride(width + 2 * kPad),
+        plane_size(std::size_t(stride) * points.height()),
+        values(6 * plane_size, 0.0f) {
+    parallel_for(static_cast<std::size_t>(points.height()), [&](std::size_t row) {
+      const int y = static_cast<int>(row);
+      for (int x = 0; x < width; ++x) {
+        const Eigen::Vector3f n = vector_at(normals, x, y);
+        if (!n.allFinite()) continue;
+        for (int c = 0; c < 3; ++c) {
+          plane(c, y)[x] = points.at(x, y, c);
+          plane(3 + c, y)[x] = n[c];
+        }
+      }
+    });
+  }
+  // Column 0 of row y of plane k: points' x, y, z (k = 0..2), normals' x, y, z (3..5).
+  float* plane(int k, int y) {
+    return values.data() + (std::size_t(k) * plane_size + std::size_t(y) * stride + kPad);
+  }
+  const float* plane(int k, int y) const { return const_cast<SurfacePlanes*>(this)->plane(k, y); }
+
+  int width, stride;
+  std::size_t plane_size;
+  std::vector<float> values;
+};
+
+constexpr int kSmoothingMaxRadiusPx = 8;
+static_assert(kSmoothingMaxRadiusPx + kLaneCount <= SurfacePlanes::kPad);
+
+// values[0, kLaneCount). (By reference: see vector_lanes.h.)
+[[gnu::always_inline]] inline void read_lanes(const float* values, Floats& lanes) {
+  std::memcpy(&lanes, values, sizeof(lanes));
+}
+
+// Row y of smooth_normals() into `smoothed`, eight centre pixels at a time: per window offset,
+// each lane adds its neighbour's normal where it is on the lane's face (within 60 degrees of
+// its normal and within radius_m of its point) and inside its window. Per pixel, the window's
+// rows were too short for vectors, and summing them up was most of the work.
+#if defined(__x86_64__)
+__attribute__((target_clones("arch=x86-64-v3", "default")))
+#endif
+void smooth_normals_row(const SurfacePlanes& planes, const ImageF& depth_m, float fx,
+                        float radius_m, int y, ImageF& smoothed) {
+  constexpr float kSameFace = 0.5f;  // cos 60 degrees
+  const int width = planes.width, height = depth_m.height();
+  const float radius_squared = radius_m * radius_m;
+  for (int x0 = 0; x0 < width; x0 += kLaneCount) {
+    // Each lane's window half-width in pixels; -1 for no normal, no depth or off the image.
+    alignas(32) std::int32_t windows[kLaneCount];
+    int widest = -1;
+    for (int lane = 0; lane < kLaneCount; ++lane) {
+      const int x = x0 + lane;
+      const float depth = x < width ? depth_m.at(x, y, 0) : 0.0f;
+      const bool has_normal =
+          planes.plane(3, y)[x] != 0 || planes.plane(4, y)[x] != 0 || planes.plane(5, y)[x] != 0;
+      windows[lane] =
+          has_normal && depth > 0
+              ? std::min(kSmoothingMaxRadiusPx, static_cast<int>(std::ceil(radius_m * fx / depth)))
+              : -1;
+      widest = std::max(widest, windows[lane]);
+    }
+    if (widest < 0) continue;
+    Ints window;
+    std::memcpy(&window, windows, sizeof(window));
+    Floats px, py, pz, nx, ny, nz;
+    read_lanes(planes.plane(0, y) + x0, px);
+    read_lanes(planes.plane(1, y) + x0, py);
+    read_lanes(planes.plane(2, y) + x0, pz);
+    read_lanes(planes.plane(3, y) + x0, nx);
+    read_lanes(planes.plane(4, y) + x0, ny);
+    read_lanes(planes.plane(5, y) + x0, nz);
+    Floats sx{}, sy{}, sz{};
+    for (int dv = -widest; dv <= widest; ++dv) {
+      const int v = y + dv;
+      if (v < 0 || v >= height) continue;
+      const Ints row_inside = window >= std::abs(dv);
+      const float *qx = planes.plane(0, v) + x0, *qy = planes.plane(1, v) + x0,
+                  *qz = planes.plane(2, v) + x0;
+      const float *mx = planes.plane(3, v) + x0, *my = planes.plane(4, v) + x0,
+                  *mz = planes.plane(5, v) + x0;
+      for (int du = -widest; du <= widest; ++du) {
+        Floats m_x, m_y, m_z, q_x, q_y, q_z;
+        read_lanes(mx + du, m_x);
+        read_lanes(my + du, m_y);
+        read_lanes(mz + du, m_z);
+        read_lanes(qx + du, q_x);
+        read_lanes(qy + du, q_y);
+        read_lanes(qz + du, q_z);
+        const Floats dx = q_x - px, dy = q_y - py, dz = q_z - pz;
+        const Ints same_face = row_inside & (window >= std::abs(du)) &
+                               (m_x * nx + m_y * ny + m_z * nz >= kSameFace) &
+                               (dx * dx + dy * dy + dz * dz <= radius_squared);
+        sx += same_face ? m_x : Floats{};
+        sy += same_face ? m_y : Floats{};
+        sz += same_face ? m_z : Floats{};
+      }
+    }
+    for (int lane = 0; lane < kLaneCount; ++lane) {
+      if (windows[lane] < 0) continue;
+      const Eigen::Vector3f mean = Eigen::Vector3f(sx[lane], sy[lane], sz[lane]).normalized();
+      for (int c = 0; c < 3; ++c) smoothed.at(x0 + lane, y, c) = mean[c];
+    }
   }
 }
 
@@ -154,31 +269,11 @@ ImageF normals_from_points(const ImageF& points, const Eigen::Vector3d& viewpoin
 
 ImageF smooth_normals(const ImageF& points, const ImageF& normals, const ImageF& depth_m,
                       const Intrinsics& intrinsics, float radius_m) {
-  const int width = points.width(), height = points.height();
-  ImageF smoothed(width, height, 3, kNaN);
-  constexpr int kMaxRadiusPx = 8;
-  constexpr float kSameFace = 0.5f;  // cos 60 degrees
-  const float radius_squared = radius_m * radius_m;
-  parallel_for(static_cast<std::size_t>(height), [&](std::size_t row) {
-    const int y = static_cast<int>(row);
-    for (int x = 0; x < width; ++x) {
-      const Eigen::Vector3f n = vector_at(normals, x, y);
-      const float depth = depth_m.at(x, y, 0);
-      if (!n.allFinite() || !(depth > 0)) continue;
-      const Eigen::Vector3f p = vector_at(points, x, y);
-      const int window = std::min(
-          kMaxRadiusPx, static_cast<int>(std::ceil(radius_m * float(intrinsics.fx) / depth)));
-      Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-      for (int v = std::max(0, y - window); v <= std::min(height - 1, y + window); ++v)
-        for (int u = std::max(0, x - window); u <= std::min(width - 1, x + window); ++u) {
-          const Eigen::Vector3f m = vector_at(normals, u, v);
-          if (!m.allFinite() || m.dot(n) < kSameFace) continue;
-          if ((vector_at(points, u, v) - p).squaredNorm() > radius_squared) continue;
-          sum += m;
-        }
-      const Eigen::Vector3f mean = sum.normalized();
-      for (int c = 0; c < 3; ++c) smoothed.at(x, y, c) = mean[c];
-    }
+  ImageF smoothed(points.width(), points.height(), 3, kNaN);
+  const SurfacePlanes planes(points, normals);
+  parallel_for(static_cast<std::size_t>(points.height()), [&](std::size_t row) {
+    smooth_normals_row(planes, depth_m, float(intrinsics.fx), radius_m, static_cast<int>(row),
+                       smoothed);
   });
   return smoothed;
 }

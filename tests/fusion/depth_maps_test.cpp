@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -81,6 +82,68 @@ TEST(SmoothNormals, ExactNormalsOfAPlaneStayExact) {
   for (int y = 0; y < kCamera.height; ++y)
     for (int x = 0; x < kCamera.width; ++x)
       ASSERT_LT(angle_deg(smoothed, ridge.true_normals, x, y), 0.05f) << x << ", " << y;
+}
+
+// smooth_normals()' definition, pixel by pixel (in double).
+ImageF smoothing_by_definition(const ImageF& points, const ImageF& normals, const ImageF& depth,
+                               const Intrinsics& camera, double radius_m) {
+  ImageF out(points.width(), points.height(), 3, NAN);
+  for (int y = 0; y < points.height(); ++y)
+    for (int x = 0; x < points.width(); ++x) {
+      const Eigen::Vector3d n(normals.at(x, y, 0), normals.at(x, y, 1), normals.at(x, y, 2));
+      const Eigen::Vector3d p(points.at(x, y, 0), points.at(x, y, 1), points.at(x, y, 2));
+      if (!n.allFinite() || !(depth.at(x, y, 0) > 0)) continue;
+      const int window =
+          std::min(8, int(std::ceil(float(radius_m) * float(camera.fx) / depth.at(x, y, 0))));
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (int v = std::max(0, y - window); v <= std::min(points.height() - 1, y + window); ++v)
+        for (int u = std::max(0, x - window); u <= std::min(points.width() - 1, x + window); ++u) {
+          const Eigen::Vector3d m(normals.at(u, v, 0), normals.at(u, v, 1), normals.at(u, v, 2));
+          const Eigen::Vector3d q(points.at(u, v, 0), points.at(u, v, 1), points.at(u, v, 2));
+          if (m.allFinite() && m.dot(n) >= 0.5 && (q - p).norm() <= radius_m) sum += m;
+        }
+      sum.normalize();
+      for (int c = 0; c < 3; ++c) out.at(x, y, c) = float(sum[c]);
+    }
+  return out;
+}
+
+TEST(SmoothNormals, MatchesItsDefinitionWithHolesBordersAndWindowsOfEveryWidth) {
+  // A 61x45 view (rows end in partial groups of lanes) of a ridge 0.6-2.6 m away, so windows
+  // range from 2 to the 8-pixel cap; pixels without a normal, and with a normal but no depth.
+  const Intrinsics camera{61, 45, 50.0, 50.0, 30.0, 22.0};
+  ImageF depth(camera.width, camera.height, 1), points(camera.width, camera.height, 3),
+      normals(camera.width, camera.height, 3);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> noise(-0.4f, 0.4f);
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x) {
+      const Eigen::Vector3d ray = camera.ray(x, y);
+      const double z = 0.6 + 2.0 * y / camera.height + 0.5 * std::abs(ray.x());
+      const Eigen::Vector3f point = (ray * z).cast<float>();
+      const Eigen::Vector3f normal =
+          (Eigen::Vector3f(ray.x() > 0 ? 1.0f : -1.0f, 0.0f, -1.0f).normalized() +
+           Eigen::Vector3f(noise(rng), noise(rng), noise(rng)))
+              .normalized();
+      depth.at(x, y, 0) = (x * 7 + y * 3) % 23 == 0 ? 0.0f : float(z);
+      for (int c = 0; c < 3; ++c) {
+        points.at(x, y, c) = point[c];
+        normals.at(x, y, c) = (x * 5 + y) % 17 == 0 ? NAN : normal[c];
+      }
+    }
+  for (const float radius : {0.05f, 0.2f}) {
+    const ImageF smoothed = smooth_normals(points, normals, depth, camera, radius);
+    const ImageF expected = smoothing_by_definition(points, normals, depth, camera, radius);
+    for (int y = 0; y < camera.height; ++y)
+      for (int x = 0; x < camera.width; ++x)
+        for (int c = 0; c < 3; ++c) {
+          if (std::isnan(expected.at(x, y, c))) {
+            ASSERT_TRUE(std::isnan(smoothed.at(x, y, c))) << x << ", " << y;
+            continue;
+          }
+          ASSERT_NEAR(smoothed.at(x, y, c), expected.at(x, y, c), 1e-5f) << x << ", " << y;
+        }
+  }
 }
 
 // The bilateral filter's definition, pixel by pixel: the mean of the window's pixels with depth,
