@@ -53,18 +53,27 @@ const char* normals_name(const reflectance::ObservationGridParams& params) {
 // The model re-rendered from `pose`: ray cast (with gradient normals at silhouettes), its normals
 // smoothed within `normal_radius_m` (0: not), and shaded with the pipeline's materials and lights.
 // `fused_depth`: the depth of the frame just fused from `pose`, if it was, which the ray cast
-// starts from (fusion::raycast's depth hint).
+// starts from (fusion::raycast's depth hint). The three steps are timed into `timings`.
 reflectance::MaterialMaps render_model(const reflectance::ReflectancePipeline& pipeline,
                                        const Intrinsics& intrinsics, const Pose& pose,
-                                       float normal_radius_m, const ImageF* fused_depth = nullptr) {
+                                       float normal_radius_m, StageTimings& timings,
+                                       const ImageF* fused_depth = nullptr) {
+  Stopwatch watch;
   fusion::SurfaceView view = fusion::raycast(pipeline.geometry(), intrinsics, pose,
                                              fusion::RaycastNormals::from_gradient, fused_depth);
-  if (normal_radius_m > 0)
+  timings.add("raycast", watch.elapsed_ms());
+  if (normal_radius_m > 0) {
+    watch.restart();
     view.normals = fusion::smooth_normals(view.points_m, view.normals, view.depth_m, intrinsics,
                                           normal_radius_m);
-  return reflectance::render_material_maps(view, pose, pipeline.observations(),
-                                           pipeline.materials(), pipeline.lights(),
-                                           pipeline.exposure(), pipeline.albedo_smoothing());
+    timings.add("smooth_normals", watch.elapsed_ms());
+  }
+  watch.restart();
+  reflectance::MaterialMaps maps = reflectance::render_material_maps(
+      view, pose, pipeline.observations(), pipeline.materials(), pipeline.lights(),
+      pipeline.exposure(), pipeline.albedo_smoothing());
+  timings.add("shade", watch.elapsed_ms());
+  return maps;
 }
 
 struct ReconstructOptions {
@@ -154,7 +163,7 @@ void run_reconstruct(ReconstructOptions options) {
   reflectance::MaterialEvaluation evaluation;
   // Per frame: read; render (the re-rendering alone), evaluate (scoring and pictures); per
   // extra view: render; mesh once.
-  StageTimings command_timings;
+  StageTimings command_timings, render_timings;
   int lost = 0;
   {
     ProgressBar progress("reconstruct", frames);
@@ -181,7 +190,7 @@ void run_reconstruct(ReconstructOptions options) {
         watch.restart();
         const reflectance::MaterialMaps maps =
             render_model(pipeline, sequence.intrinsics, result.geometry.camera_to_world,
-                         options.render_normal_radius_m, &frame.depth_m);
+                         options.render_normal_radius_m, render_timings, &frame.depth_m);
         command_timings.add("render", watch.elapsed_ms());
         watch.restart();
         if (evaluate) evaluation.add_frame(int(i), maps, *truth, frame.colour);
@@ -199,8 +208,9 @@ void run_reconstruct(ReconstructOptions options) {
     ProgressBar progress("views", views.size());
     for (std::size_t k = 0; k < views.size(); ++k) {
       Stopwatch watch;
-      const reflectance::MaterialMaps maps = render_model(
-          pipeline, sequence.intrinsics, views[k].pose, options.render_normal_radius_m);
+      const reflectance::MaterialMaps maps =
+          render_model(pipeline, sequence.intrinsics, views[k].pose, options.render_normal_radius_m,
+                       render_timings);
       command_timings.add("render", watch.elapsed_ms());
       write_view_pictures((fs::path(options.output) / "views").string(), int(k), maps);
       progress.advance();
@@ -265,6 +275,7 @@ void run_reconstruct(ReconstructOptions options) {
        {"timings_ms", timings.to_json()},
        {"geometry_timings_ms", pipeline.geometry_timings().to_json()},
        {"command_timings_ms", command},
+       {"render_timings_ms", render_timings.to_json()},
        {"materials", materials_json(pipeline)},
        {"evaluation", has_truth ? evaluation.to_json() : nlohmann::json(nullptr)},
        {"total_s", total.elapsed_s()}});

@@ -91,6 +91,9 @@ TEST_F(ReconstructCli, TracksTheCameraAgainstAHalfResolutionModel) {
   EXPECT_EQ(report["geometry_timings_ms"]["track"]["count"], 23);
   EXPECT_EQ(report["geometry_timings_ms"]["raycast"]["count"], 24);
   EXPECT_EQ(report["geometry_timings_ms"]["integrate"]["count"], 24);
+  // The last frame's re-rendering, in its three steps.
+  for (const char* step : {"raycast", "smooth_normals", "shade"})
+    EXPECT_EQ(report["render_timings_ms"][step]["count"], 1) << step;
   EXPECT_GE(io::read_json(path("tracked") + "/materials.json")["segments"].size(), 2u);
 }
 
