@@ -102,8 +102,8 @@ class TileDepthRanges {
 // Voxels a ray skips per step through unobserved voxels of allocated blocks (space behind
 // surfaces, or beside them, that no frame saw). Landing on observed space after such a stride,
 // it steps back and crosses the stride again voxel by voxel, so only an observed stretch
-// shorter than the stride can be missed; the truncation band in front of any surface is at
-// least 4 voxels deep (2 cm, 5 mm voxels).
+// shorter than the stride can be missed; with the default band (at least 2 cm) and 5 mm voxels,
+// the observed band in front of any surface is at least 4 voxels deep.
 constexpr int kUnobservedStride = 3;
 
 // Depth t (metres along the optical axis) of the first + to - crossing along origin + t * ray,

@@ -80,13 +80,13 @@ class TsdfSampler {
     const int x = round_to_int(v.x()), y = round_to_int(v.y()), z = round_to_int(v.z());
     if (voxel(x, y, z, unused) != Sample::observed) return Eigen::Vector3f::Zero();
     const int index = voxel_in_block(x, y, z);
-    const int block = cached_block(x >> 3, y >> 3, z >> 3);
+    const int block = cached_block(x >> kBlockShift, y >> kBlockShift, z >> kBlockShift);
     return {volume_.red(block)[index], volume_.green(block)[index], volume_.blue(block)[index]};
   }
 
   // Global voxel coordinates -> its sample.
   Sample voxel(int x, int y, int z, float& sdf_m) {
-    const int block = cached_block(x >> 3, y >> 3, z >> 3);  // floor division by 8
+    const int block = cached_block(x >> kBlockShift, y >> kBlockShift, z >> kBlockShift);
     if (block < 0) return Sample::unallocated;
     const int index = voxel_in_block(x, y, z);
     const float sdf = volume_.sdf_m(block)[index];
@@ -103,6 +103,9 @@ class TsdfSampler {
                 lerp(lerp(corner[4], corner[5], fx), lerp(corner[6], corner[7], fx), fy), fz);
   }
   static int round_to_int(float value) { return static_cast<int>(std::floor(value + 0.5f)); }
+  // Block coordinates of a voxel: floor division by the block side, as a shift.
+  static constexpr int kBlockShift = 3;
+  static_assert(kBlockSide == 1 << kBlockShift);
 
   // Reads voxel (x0 + a, y0 + b, z0 + c) into box[a][b][c] for each (a, b, c) that wanted()
   // names; false when one of them is unallocated or unobserved. A box of at most a block's side
@@ -117,9 +120,9 @@ class TsdfSampler {
     int side_x[kSpan], side_y[kSpan], side_z[kSpan], offset_x[kSpan], offset_y[kSpan],
         offset_z[kSpan];
     for (int i = 0; i < kSpan; ++i) {
-      side_x[i] = ((x0 + i) >> 3) - (x0 >> 3);
-      side_y[i] = ((y0 + i) >> 3) - (y0 >> 3);
-      side_z[i] = ((z0 + i) >> 3) - (z0 >> 3);
+      side_x[i] = ((x0 + i) >> kBlockShift) - (x0 >> kBlockShift);
+      side_y[i] = ((y0 + i) >> kBlockShift) - (y0 >> kBlockShift);
+      side_z[i] = ((z0 + i) >> kBlockShift) - (z0 >> kBlockShift);
       offset_x[i] = (x0 + i) & last;
       offset_y[i] = ((y0 + i) & last) * kBlockSide;
       offset_z[i] = ((z0 + i) & last) * kBlockSide * kBlockSide;
@@ -128,7 +131,8 @@ class TsdfSampler {
     for (int c = 0; c <= side_z[kSpan - 1]; ++c)
       for (int b = 0; b <= side_y[kSpan - 1]; ++b)
         for (int a = 0; a <= side_x[kSpan - 1]; ++a) {
-          const int block = cached_block((x0 >> 3) + a, (y0 >> 3) + b, (z0 >> 3) + c);
+          const int block = cached_block((x0 >> kBlockShift) + a, (y0 >> kBlockShift) + b,
+                                         (z0 >> kBlockShift) + c);
           blocks[a][b][c] = block < 0 ? nullptr : volume_.sdf_m(block);
         }
     for (int a = 0; a < kSpan; ++a)
