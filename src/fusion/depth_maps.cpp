@@ -226,6 +226,17 @@ const ImageF& halved_depth(const ImageF& depth_m, int halvings, double sigma_dep
   return halvings == 0 ? depth_m : storage;
 }
 
+Intrinsics halved_intrinsics(const Intrinsics& intrinsics, int halvings) {
+  Intrinsics halved = intrinsics;
+  for (int level = 0; level < halvings; ++level) {
+    const int width = halved.width / 2, height = halved.height / 2;
+    halved = halved.scaled(0.5);
+    halved.width = width;
+    halved.height = height;
+  }
+  return halved;
+}
+
 ImageF points_from_depth(const ImageF& depth_m, const Intrinsics& intrinsics) {
   ImageF points(depth_m.width(), depth_m.height(), 3);
   const float* depth = depth_m.plane(0);

@@ -27,6 +27,10 @@ ImageF downsample_depth(const ImageF& depth_m, double sigma_depth_m);
 const ImageF& halved_depth(const ImageF& depth_m, int halvings, double sigma_depth_m,
                            ImageF& storage);
 
+// The camera of an image of `intrinsics`' size halved `halvings` times as downsample_depth()
+// halves it: scaled by 1/2 each time, an odd last row / column dropped.
+Intrinsics halved_intrinsics(const Intrinsics& intrinsics, int halvings);
+
 // Camera-space points of a depth map.
 ImageF points_from_depth(const ImageF& depth_m, const Intrinsics& intrinsics);
 

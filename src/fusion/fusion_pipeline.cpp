@@ -1,6 +1,5 @@
 #include "fusion/fusion_pipeline.h"
 
-#include <cmath>
 #include <string>
 
 #include "core/error.h"
@@ -25,11 +24,7 @@ Pose FusionPipeline::predict_pose() const {
 }
 
 Intrinsics FusionPipeline::model_intrinsics() const {
-  Intrinsics model = intrinsics_.scaled(std::ldexp(1.0, -params_.tracking.model_halvings));
-  // The size of the depth halved as often (downsample_depth() drops an odd last row / column).
-  model.width = intrinsics_.width >> params_.tracking.model_halvings;
-  model.height = intrinsics_.height >> params_.tracking.model_halvings;
-  return model;
+  return halved_intrinsics(intrinsics_, params_.tracking.model_halvings);
 }
 
 FrameResult FusionPipeline::process(const io::RgbdFrame& frame) {

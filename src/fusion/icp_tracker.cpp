@@ -46,9 +46,7 @@ std::vector<PyramidLevel> build_pyramid(const ImageF& depth_m, const Intrinsics&
   for (std::size_t level = 0; level < params.iterations.size(); ++level) {
     if (level > 0) {
       depth = downsample_depth(depth, params.bilateral.sigma_depth_m);
-      k = k.scaled(0.5);
-      k.width = depth.width();  // the 2x2 reduction drops an odd last row / column
-      k.height = depth.height();
+      k = halved_intrinsics(k, 1);
     }
     ImageF points = points_from_depth(depth, k);
     ImageF normals = normals_from_points(points, Eigen::Vector3d::Zero());

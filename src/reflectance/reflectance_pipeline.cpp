@@ -117,9 +117,8 @@ const Image<std::int32_t>& ReflectancePipeline::segment_frame(const ImageF& dept
   ImageF halved;
   const ImageF& depth = fusion::halved_depth(
       depth_m, shift, params_.geometry.tracking.bilateral.sigma_depth_m, halved);
-  Intrinsics intrinsics = intrinsics_;
-  for (int level = 0; level < shift; ++level) intrinsics = intrinsics.scaled(0.5);
-  const Image<std::int32_t>& coarse = depth_segmenter_.segment(depth, intrinsics).labels;
+  const Image<std::int32_t>& coarse =
+      depth_segmenter_.segment(depth, fusion::halved_intrinsics(intrinsics_, shift)).labels;
   if (shift == 0) return coarse;
   // Every full-resolution pixel takes the label of the coarse pixel covering it.
   if (frame_labels_.width() != depth_m.width() || frame_labels_.height() != depth_m.height())
