@@ -8,6 +8,7 @@
 #include <array>
 #include <bit>
 #include <cstdint>
+#include <vector>
 
 namespace glint::reflectance {
 
@@ -76,5 +77,14 @@ inline constexpr int kMaxObservationsPerVoxel = 255;
 // nearest one was dropped; no allocation.
 int insert_observation(Observation* slots, NearestObservation* nearest, int count, int capacity,
                        const Observation& added);
+
+// The instruction sets insert_observation() has a kernel for; all give the same result bit for
+// bit, and it runs the widest the CPU has.
+enum class InsertionKernel { kScalar, kAvx2, kAvx512 };
+// Those this CPU can run, narrowest first.
+std::vector<InsertionKernel> supported_insertion_kernels();
+// insert_observation() with one of supported_insertion_kernels() (tests compare each).
+int insert_observation(InsertionKernel kernel, Observation* slots, NearestObservation* nearest,
+                       int count, int capacity, const Observation& added);
 
 }  // namespace glint::reflectance

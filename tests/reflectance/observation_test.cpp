@@ -22,6 +22,9 @@ struct Voxel {
   void insert(const Observation& o) {
     count = insert_observation(slots.data(), nearest.data(), count, capacity, o);
   }
+  void insert(InsertionKernel kernel, const Observation& o) {
+    count = insert_observation(kernel, slots.data(), nearest.data(), count, capacity, o);
+  }
   std::vector<Observation> slots;
   std::vector<NearestObservation> nearest;
   int capacity, count = 0;
@@ -93,21 +96,53 @@ TEST(Observations, FillUpToCapacityThenStayFull) {
   EXPECT_EQ(none.count, 0);
 }
 
+// Every kernel this CPU can run (scalar, AVX2, AVX-512), not only the one insert_observation()
+// picks. Capacities around the vector widths (8, 16) and the largest the slots allow.
 TEST(Observations, KeepsTheSameObservationsAsTheBruteForceDefinition) {
-  std::mt19937 random(7);
+  for (const InsertionKernel kernel : supported_insertion_kernels()) {
+    std::mt19937 random(7);
+    std::uniform_real_distribution<float> theta(0.0f, 1.5f), phi(0.0f, 6.283f);
+    for (int capacity : {2, 5, 8, 9, 17, 30, 70, kMaxObservationsPerVoxel}) {
+      Voxel voxel(capacity);
+      std::vector<Observation> reference(capacity);
+      int reference_count = 0;
+      const int frames = capacity == kMaxObservationsPerVoxel ? 400 : 300;
+      for (std::uint32_t f = 0; f < std::uint32_t(frames); ++f) {
+        const Observation o = seen_from(theta(random), phi(random), f);
+        voxel.insert(kernel, o);
+        reference_count = reference_insert(reference, reference_count, capacity, o);
+        ASSERT_EQ(voxel.count, reference_count);
+        for (int k = 0; k < capacity && k < voxel.count; ++k)
+          ASSERT_EQ(voxel.slots[k].frame(), reference[k].frame())
+              << "kernel " << int(kernel) << " capacity " << capacity << " frame " << f;
+      }
+    }
+  }
+}
+
+// The kernels agree bit for bit: the same slots, and the same nearest entries (similarities and
+// slots), after every insertion.
+TEST(Observations, EveryInsertionKernelKeepsTheSameSlotsAndNearestEntries) {
+  const std::vector<InsertionKernel> kernels = supported_insertion_kernels();
+  ASSERT_EQ(kernels.front(), InsertionKernel::kScalar);
+  std::mt19937 random(11);
   std::uniform_real_distribution<float> theta(0.0f, 1.5f), phi(0.0f, 6.283f);
-  for (int capacity : {2, 5, 17, 30, 70}) {  // the vectorised searches work 16 at a time
-    Voxel voxel(capacity);
-    std::vector<Observation> reference(capacity);
-    int reference_count = 0;
-    for (std::uint32_t f = 0; f < 400; ++f) {
-      const Observation o = seen_from(theta(random), phi(random), f);
-      voxel.insert(o);
-      reference_count = reference_insert(reference, reference_count, capacity, o);
-      ASSERT_EQ(voxel.count, reference_count);
-      for (int k = 0; k < capacity && k < voxel.count; ++k)
-        ASSERT_EQ(voxel.slots[k].frame(), reference[k].frame())
-            << "capacity " << capacity << " frame " << f;
+  for (int capacity : {3, 16, 30, 33}) {
+    std::vector<Voxel> voxels(kernels.size(), Voxel(capacity));
+    for (std::uint32_t f = 0; f < 500; ++f) {
+      // Repeats of earlier directions too: ties between equally similar pairs.
+      const Observation o =
+          f % 7 == 6 ? seen_from(0.5f, 1.0f, f) : seen_from(theta(random), phi(random), f);
+      for (std::size_t k = 0; k < kernels.size(); ++k) voxels[k].insert(kernels[k], o);
+      for (std::size_t k = 1; k < kernels.size(); ++k) {
+        ASSERT_EQ(voxels[k].count, voxels[0].count);
+        for (int i = 0; i < voxels[0].count; ++i) {
+          ASSERT_EQ(voxels[k].slots[i].frame(), voxels[0].slots[i].frame())
+              << "kernel " << int(kernels[k]) << " capacity " << capacity << " frame " << f;
+          ASSERT_EQ(voxels[k].nearest[i].similarity, voxels[0].nearest[i].similarity);
+          ASSERT_EQ(voxels[k].nearest[i].slot, voxels[0].nearest[i].slot);
+        }
+      }
     }
   }
 }
