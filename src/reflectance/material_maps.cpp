@@ -90,16 +90,23 @@ Cell cell_of(const ObservationGrid& grid, const Eigen::Vector3f& p) {
   return {base, g - base.cast<float>()};
 }
 
-// Fills `around` for the cell at `base` and `segment`, unless it holds them already.
-void look_up(const ObservationGrid& grid, const Eigen::Vector3i& base, int segment,
-             RefinedNeighbourhood& around, ObservationGrid::BlockCache* cache = nullptr) {
-  if (around.segment == segment && around.base == base) return;
+// Fills `around`'s voxels for the cell at `base`, unless it holds them already.
+void look_up(const ObservationGrid& grid, const Eigen::Vector3i& base, RefinedNeighbourhood& around,
+             ObservationGrid::BlockCache* cache = nullptr) {
+  if (around.base == base) return;
   around.base = base;
+  around.segment = -1;
+  grid.find_voxels(base - Eigen::Vector3i::Ones(), 4, around.grid_voxels.data(), cache);
+}
+
+// Fills `around`'s refined albedos of `segment` (its voxels looked up), unless it holds them.
+void select_segment(const ObservationGrid& grid, int segment, RefinedNeighbourhood& around) {
+  if (around.segment == segment) return;
   around.segment = segment;
-  grid.find_voxels(base - Eigen::Vector3i::Ones(), 4, around.voxels.data(), cache);
   around.reliable = 0;
   for (int i = 0; i < 64; ++i) {
     int& v = around.voxels[std::size_t(i)];
+    v = around.grid_voxels[std::size_t(i)];
     if (v >= 0 && !(grid.segment(v) == segment && grid.has_refined_kd(v))) v = -1;
     if (v < 0 || !grid.refined_kd_reliable(v)) continue;
     const Eigen::Vector3f& kd = grid.refined_kd(v);
@@ -188,28 +195,37 @@ bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& 
                             Eigen::Vector3f& kd, bool unreliable_corners, float smoothing) {
   const Cell cell = cell_of(grid, p);
   RefinedNeighbourhood around;
-  look_up(grid, cell.base, segment, around);
+  look_up(grid, cell.base, around);
+  select_segment(grid, segment, around);
   return interpolate(grid, around, cell.t, kd, unreliable_corners, smoothing);
 }
 
 namespace {
 
-// Segment of the voxel holding p, else of the nearest labelled of its 26 neighbours.
+// Segment of the voxel holding p, else of the nearest labelled of its 26 neighbours; `around`
+// holds the voxels of p's trilinear cell (look_up()).
 int segment_at(const ObservationGrid& grid, const Eigen::Vector3f& p,
-               ObservationGrid::BlockCache& cache) {
-  const int v = grid.find(p, &cache);
-  if (v >= 0 && grid.segment(v) > 0) return grid.segment(v);
+               const RefinedNeighbourhood& around) {
   const float size = float(grid.params().voxel_size_m);
   const Eigen::Vector3f g = p / size;
   const Eigen::Vector3i centre(int(std::floor(g.x())), int(std::floor(g.y())),
                                int(std::floor(g.z())));
+  // p's voxel in the 4^3 from base - 1: 1 or 2 along each axis (the cell's base is p's voxel or
+  // the one below it), so its 3^3 lie within.
+  const Eigen::Vector3i first = around.base - Eigen::Vector3i::Ones();
+  const auto voxel_at = [&](const Eigen::Vector3i& voxel) {
+    const Eigen::Vector3i d = voxel - first;
+    return around.grid_voxels[std::size_t((d.z() * 4 + d.y()) * 4 + d.x())];
+  };
+  const int v = voxel_at(centre);
+  if (v >= 0 && grid.segment(v) > 0) return grid.segment(v);
   int best = 0;
   float best_distance = INFINITY;
   for (int dz = -1; dz <= 1; ++dz)
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
         const Eigen::Vector3i voxel = centre + Eigen::Vector3i(dx, dy, dz);
-        const int n = grid.find_voxel(voxel, &cache);
+        const int n = voxel_at(voxel);
         if (n < 0 || grid.segment(n) <= 0) continue;
         const float distance = (grid.voxel_centre(voxel) - p).squaredNorm();
         if (distance < best_distance) best = grid.segment(n), best_distance = distance;
@@ -220,13 +236,14 @@ int segment_at(const ObservationGrid& grid, const Eigen::Vector3f& p,
 }  // namespace
 
 bool MaterialLookup::operator()(const Eigen::Vector3f& p, PointMaterial& material) {
-  material.segment = segment_at(grid_, p, blocks_);
+  const Cell cell = cell_of(grid_, p);
+  look_up(grid_, cell.base, around_, &blocks_);
+  material.segment = segment_at(grid_, p, around_);
   const SegmentMaterial* fused = materials_.material(material.segment);
   if (!fused) return false;
   material.fused = material.refined = fused->ward;
   if (fused->kd_refined) material.refined.kd = *fused->kd_refined;
-  const Cell cell = cell_of(grid_, p);
-  look_up(grid_, cell.base, material.segment, around_, &blocks_);
+  select_segment(grid_, material.segment, around_);
   interpolate(grid_, around_, cell.t, material.refined.kd, !fused->kd_refined, albedo_smoothing_);
   return true;
 }

@@ -61,10 +61,12 @@ bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& 
                             Eigen::Vector3f& kd, bool unreliable_corners = true,
                             float smoothing = 0);
 
-// The refined albedos of one segment's voxels in the 4^3 around a trilinear cell (from the
-// cell's first corner - 1, x fastest): pool indices, -1 where no voxel of the segment has one.
+// The observation voxels of the 4^3 around a trilinear cell (from the cell's first corner - 1,
+// x fastest), and of those the voxels of one segment with a refined albedo: pool indices, -1
+// where there is none. The 4^3 holds the 3^3 around the voxel holding any point of the cell.
 struct RefinedNeighbourhood {
   Eigen::Vector3i base = Eigen::Vector3i::Constant(std::numeric_limits<int>::min());
+  std::array<int, 64> grid_voxels{};
   int segment = -1;
   std::array<int, 64> voxels{};
   // Those with a reliable refined albedo, as arrays for the smoothing's vectorised loop: the
@@ -85,9 +87,9 @@ struct PointMaterial {
 // interpolate_refined_kd() with `albedo_smoothing`; false when p lies in no segment with a
 // material yet. Meant for many points of one model, such as a re-rendering's pixels or a mesh's
 // vertices, in an order where neighbours follow each other: it keeps the last point's
-// refined-albedo neighbourhood (64 voxels), which the next point mostly shares, and the grid
-// blocks it found last (ObservationGrid::BlockCache). One per thread; the grid must not change
-// while it is in use.
+// neighbourhood (64 voxels, which serve both its segment and its refined albedo), which the next
+// point mostly shares, and the grid blocks it found last (ObservationGrid::BlockCache). One per
+// thread; the grid must not change while it is in use.
 class MaterialLookup {
  public:
   MaterialLookup(const ObservationGrid& grid, const SpecularEstimator& materials,
