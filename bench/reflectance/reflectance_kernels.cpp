@@ -64,13 +64,36 @@ void HemiImage(benchmark::State& state) {
 }
 BENCHMARK(HemiImage)->Unit(benchmark::kMicrosecond);
 
-// Arg: 0 = each new direction drawn at random over the hemisphere; 1 = directions along a
-// smooth camera path (each close to the one before, as in a video), the pipeline's usual case:
+// The insertion kernel of argument `arg` (InsertionKernel: 0 scalar, 1 AVX2, 2 AVX-512); false,
+// with the benchmark skipped, where this CPU cannot run it.
+bool with_kernel(benchmark::State& state, int arg, InsertionKernel& kernel) {
+  kernel = InsertionKernel(state.range(arg));
+  for (const InsertionKernel supported : supported_insertion_kernels())
+    if (supported == kernel) return true;
+  state.SkipWithError("this CPU has no such instruction set");
+  return false;
+}
+
+// Directions along a smooth camera path (each close to the one before, as in a video), the
+// pipeline's usual case: about 0.6 degrees per frame.
+std::vector<Observation> along_path(std::vector<Observation> observations) {
+  for (std::size_t k = 0; k < observations.size(); ++k) {
+    const float t = 0.01f * float(k);
+    observations[k] = Observation(
+        observations[k].colour(),
+        Eigen::Vector3f(0.6f * std::cos(t), 0.6f * std::sin(1.3f * t), 0.8f).normalized(),
+        observations[k].frame());
+  }
+  return observations;
+}
+
+// Arg 0: 0 = each new direction drawn at random over the hemisphere; 1 = along a camera path:
 // the dropped observation is then mostly the newest stored one. Both cycle through 64 voxels so
-// that the branch predictor cannot learn one voxel's comparisons.
+// that the branch predictor cannot learn one voxel's comparisons. Arg 1: the kernel.
 void InsertIntoFullVoxel(benchmark::State& state) {
+  InsertionKernel kernel;
+  if (!with_kernel(state, 1, kernel)) return;
   constexpr int kVoxels = 64;
-  const bool along_path = state.range(0) == 1;
   std::vector<std::vector<Observation>> slots(kVoxels);
   std::vector<std::vector<NearestObservation>> nearest(kVoxels);
   for (int v = 0; v < kVoxels; ++v) {
@@ -78,27 +101,39 @@ void InsertIntoFullVoxel(benchmark::State& state) {
     nearest[v].resize(30);
     int count = 0;
     for (const Observation& o : random_observations(30, 3 + v))
-      count = insert_observation(slots[v].data(), nearest[v].data(), count, 30, o);
+      count = insert_observation(kernel, slots[v].data(), nearest[v].data(), count, 30, o);
   }
   std::vector<Observation> incoming = random_observations(1024, 4);
-  if (along_path)
-    for (std::size_t k = 0; k < incoming.size(); ++k) {
-      const float t = 0.01f * float(k);  // about 0.6 degrees per frame
-      incoming[k] = Observation(
-          incoming[k].colour(),
-          Eigen::Vector3f(0.6f * std::cos(t), 0.6f * std::sin(1.3f * t), 0.8f).normalized(),
-          incoming[k].frame());
-    }
+  if (state.range(0) == 1) incoming = along_path(incoming);
   std::size_t next = 0;
   for (auto _ : state) {
     const int v = int(next % kVoxels);
     const Observation& next_seen = incoming[(next / kVoxels) % incoming.size()];
     const Observation added(next_seen.colour(), next_seen.direction(), std::uint32_t(100 + next));
     ++next;
-    benchmark::DoNotOptimize(insert_observation(slots[v].data(), nearest[v].data(), 30, 30, added));
+    benchmark::DoNotOptimize(
+        insert_observation(kernel, slots[v].data(), nearest[v].data(), 30, 30, added));
   }
 }
-BENCHMARK(InsertIntoFullVoxel)->Arg(0)->Arg(1)->Unit(benchmark::kNanosecond);
+BENCHMARK(InsertIntoFullVoxel)->ArgsProduct({{0, 1}, {0, 1, 2}})->Unit(benchmark::kNanosecond);
+
+// A voxel filled from empty to its 30 slots along a camera path, over and over: the insertions
+// into voxels not yet full, about half of the pipeline's (cubes, 1 cm grid). Arg: the kernel.
+void InsertIntoFillingVoxel(benchmark::State& state) {
+  InsertionKernel kernel;
+  if (!with_kernel(state, 0, kernel)) return;
+  const std::vector<Observation> incoming = along_path(random_observations(30, 5));
+  std::vector<Observation> slots(30);
+  std::vector<NearestObservation> nearest(30);
+  for (auto _ : state) {
+    int count = 0;
+    for (const Observation& o : incoming)
+      count = insert_observation(kernel, slots.data(), nearest.data(), count, 30, o);
+    benchmark::DoNotOptimize(count);
+  }
+  state.SetItemsProcessed(state.iterations() * std::int64_t(incoming.size()));
+}
+BENCHMARK(InsertIntoFillingVoxel)->DenseRange(0, 2)->Unit(benchmark::kNanosecond);
 
 // Arg: 0 = the paper's mean of the per-observation albedos, 1 = the median.
 // Cycles through 256 voxels (64 KB of observations, in cache): with a single voxel the branch
