@@ -106,8 +106,7 @@ TEST(Observations, KeepsTheSameObservationsAsTheBruteForceDefinition) {
       Voxel voxel(capacity);
       std::vector<Observation> reference(capacity);
       int reference_count = 0;
-      const int frames = capacity == kMaxObservationsPerVoxel ? 400 : 300;
-      for (std::uint32_t f = 0; f < std::uint32_t(frames); ++f) {
+      for (std::uint32_t f = 0; f < 400; ++f) {
         const Observation o = seen_from(theta(random), phi(random), f);
         voxel.insert(kernel, o);
         reference_count = reference_insert(reference, reference_count, capacity, o);
