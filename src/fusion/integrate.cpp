@@ -136,7 +136,7 @@ template <auto depth_at, int kRows>
 }
 
 // Fuses the block whose voxel (0, 0, 0) is at `origin` (camera coordinates); fused_pixel has
-// one entry per voxel, as integrate_row(). The blocks of a frame lie scattered in the pools,
+// one entry per voxel, as integrate_rows(). The blocks of a frame lie scattered in the pools,
 // so the hardware prefetcher cannot guess the next one: each row fused here fetches the matching
 // row of the next block (`next_sdf_m`, `next_weight`), which hid about half the cache misses.
 template <auto depth_at>
@@ -196,7 +196,7 @@ using BlockKernel = void (*)(const FrameConstants&, const float[3], float*, floa
 // The same block kernel with AVX-512 intrinsics, two rows per 16-lane register: rows y and y+1
 // of a slice are 16 consecutive voxels in the pools. (GCC 12 compiles 16-lane vector-extension
 // compares into scalar code, so this one is written with intrinsics.) Per lane it is
-// integrate_row()'s arithmetic in the same order.
+// integrate_rows()'s arithmetic in the same order.
 [[gnu::target("arch=x86-64-v4")]] void integrate_block_x86_64_v4(
     const FrameConstants& constants, const float origin[3], float* sdf_m, float* weight,
     std::int32_t* fused_pixel, const float* next_sdf_m, const float* next_weight) {
