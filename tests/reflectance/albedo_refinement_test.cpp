@@ -87,29 +87,33 @@ TEST(AlbedoRefinement, MedianIsThePerChannelMedianForEveryCount) {
   const Eigen::Vector3f normal = Eigen::Vector3f::UnitY();
   std::mt19937 random(7);
   std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
-  for (int n = 1; n <= 40; ++n) {  // across the 32 of the sorting network
-    std::vector<Observation> obs;
-    std::array<std::vector<float>, 3> albedos;
-    for (int k = 0; k < n; ++k) {
-      const Eigen::Vector3f direction =
-          Eigen::Vector3f(uniform(random) - 0.5f, 1, uniform(random) - 0.5f).normalized();
-      Eigen::Vector3f colour;
-      for (int c = 0; c < 3; ++c)  // few distinct values, so that ties occur
-        colour[c] = std::round(uniform(random) * 8) / 8 / float(M_PI);
-      obs.emplace_back(colour, direction, k);
-      // The albedo of the colour as stored (binary16).
-      for (int c = 0; c < 3; ++c) albedos[c].push_back(obs.back().colour()[c] * float(M_PI));
+  // Counts across the 32 of the sorting network; few distinct values, so that ties occur, and
+  // values spread over [0, 1].
+  for (const bool ties : {true, false})
+    for (int n = 1; n <= 40; ++n) {
+      std::vector<Observation> obs;
+      std::array<std::vector<float>, 3> albedos;
+      for (int k = 0; k < n; ++k) {
+        const Eigen::Vector3f direction =
+            Eigen::Vector3f(uniform(random) - 0.5f, 1, uniform(random) - 0.5f).normalized();
+        Eigen::Vector3f colour;
+        for (int c = 0; c < 3; ++c)
+          colour[c] = (ties ? std::round(uniform(random) * 8) / 8 : uniform(random)) / float(M_PI);
+        obs.emplace_back(colour, direction, k);
+        // The albedo of the colour as stored (binary16).
+        for (int c = 0; c < 3; ++c) albedos[c].push_back(obs.back().colour()[c] * float(M_PI));
+      }
+      const auto refined = refine_albedo(obs.data(), n, Eigen::Vector3f::Zero(), normal, lights,
+                                         {0, 0, 0}, 0.1f, AlbedoAverage::median);
+      ASSERT_TRUE(refined);
+      for (int c = 0; c < 3; ++c) {
+        std::sort(albedos[c].begin(), albedos[c].end());
+        const float expected =
+            n % 2 ? albedos[c][n / 2] : 0.5f * (albedos[c][n / 2 - 1] + albedos[c][n / 2]);
+        EXPECT_NEAR(refined->kd[c], expected, 1e-6f)
+            << n << " observations, channel " << c << (ties ? ", with ties" : "");
+      }
     }
-    const auto refined = refine_albedo(obs.data(), n, Eigen::Vector3f::Zero(), normal, lights,
-                                       {0, 0, 0}, 0.1f, AlbedoAverage::median);
-    ASSERT_TRUE(refined);
-    for (int c = 0; c < 3; ++c) {
-      std::sort(albedos[c].begin(), albedos[c].end());
-      const float expected =
-          n % 2 ? albedos[c][n / 2] : 0.5f * (albedos[c][n / 2 - 1] + albedos[c][n / 2]);
-      EXPECT_NEAR(refined->kd[c], expected, 1e-6f) << n << " observations, channel " << c;
-    }
-  }
 }
 
 TEST(AlbedoRefinement, LightCosineIsTheEffectiveIncidenceOfTheLights) {
