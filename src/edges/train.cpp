@@ -8,6 +8,7 @@
 #include <cmath>
 #include <random>
 
+#include "core/best_parameters.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/progress.h"
@@ -336,10 +337,8 @@ Model train_model(const TrainingSet& data, const ModelConfig& config, const Trai
   };
 
   nlohmann::json history = nlohmann::json::array();
-  std::vector<torch::Tensor> best_parameters;
+  BestParameters<torch::Tensor> best_parameters;
   Evaluation best;
-  best.loss = std::numeric_limits<double>::infinity();
-  int best_iteration = -1;
   double window_loss = 0.0, last_train_loss = std::nan("");
   int window_size = 0;
 
@@ -376,25 +375,15 @@ Model train_model(const TrainingSet& data, const ModelConfig& config, const Trai
           "{:.4f}, recall per class {}",
           iteration, params.iterations, last_train_loss, validation.loss, validation.accuracy,
           recall_json(validation.recall).dump());
-      if (validation.loss < best.loss) {
-        best = validation;
-        best_iteration = iteration;
-        best_parameters.clear();
-        for (const torch::Tensor& p : net->parameters())
-          best_parameters.push_back(p.detach().clone());
-      }
+      if (best_parameters.offer(net->parameters(), validation.loss, iteration)) best = validation;
     }
     history.push_back(entry);
   }
   progress.finish();
 
-  if (!best_parameters.empty()) {
-    torch::NoGradGuard no_grad;
-    std::vector<torch::Tensor> parameters = net->parameters();
-    for (std::size_t i = 0; i < parameters.size(); ++i) parameters[i].copy_(best_parameters[i]);
-    log().info("kept the weights of iteration {} (lowest validation loss {:.5f})", best_iteration,
-               best.loss);
-  }
+  if (best_parameters.restore(net->parameters()))
+    log().info("kept the weights of iteration {} (lowest validation loss {:.5f})",
+               best_parameters.step(), best.loss);
   nlohmann::json threshold = nullptr;
   if (params.tune_threshold && !split.validation.empty()) {
     const double offset = tune_non_edge_offset(evaluation_logits(net, validation_features),
@@ -410,8 +399,8 @@ Model train_model(const TrainingSet& data, const ModelConfig& config, const Trai
   for (const auto& points : split.training) training_counts.push_back(points.size());
   for (std::int64_t p : split.validation) ++validation_counts[data.labels[p]];
   nlohmann::json final_losses{{"train_loss", last_train_loss}};
-  if (best_iteration > 0)
-    final_losses.update({{"best_iteration", best_iteration},
+  if (best_parameters.step() > 0)
+    final_losses.update({{"best_iteration", best_parameters.step()},
                          {"validation_loss", best.loss},
                          {"validation_accuracy", best.accuracy},
                          {"validation_recall", recall_json(best.recall)}});

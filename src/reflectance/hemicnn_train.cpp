@@ -5,10 +5,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <numeric>
 #include <random>
 
+#include "core/best_parameters.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/progress.h"
@@ -338,9 +338,7 @@ HemiCnn train_hemicnn(const HemiDataset& data, HemiCnnConfig config,
   SetSampler sampler(data, params.set_size);
 
   nlohmann::json history = nlohmann::json::array();
-  std::vector<torch::Tensor> best_parameters;
-  double best_loss = std::numeric_limits<double>::infinity();
-  int best_batch = -1;
+  BestParameters<torch::Tensor> best_parameters;
   double window_loss = 0.0, last_train_loss = std::nan("");
   int window_size = 0;
 
@@ -378,30 +376,21 @@ HemiCnn train_hemicnn(const HemiDataset& data, HemiCnnConfig config,
       entry["validation_loss"] = validation_loss;
       log().info("batch {}/{}: training loss {:.5f}, validation loss {:.5f}", batch, params.batches,
                  last_train_loss, validation_loss);
-      if (validation_loss < best_loss) {
-        best_loss = validation_loss;
-        best_batch = batch;
-        best_parameters.clear();
-        for (const torch::Tensor& p : net->parameters())
-          best_parameters.push_back(p.detach().clone());
-      }
+      best_parameters.offer(net->parameters(), validation_loss, batch);
     }
     history.push_back(entry);
   }
   progress.finish();
 
-  if (!best_parameters.empty()) {
-    torch::NoGradGuard no_grad;
-    std::vector<torch::Tensor> parameters = net->parameters();
-    for (std::size_t i = 0; i < parameters.size(); ++i) parameters[i].copy_(best_parameters[i]);
-    log().info("kept the weights of batch {} (lowest validation loss {:.5f})", best_batch,
-               best_loss);
-  }
+  if (best_parameters.restore(net->parameters()))
+    log().info("kept the weights of batch {} (lowest validation loss {:.5f})",
+               best_parameters.step(), best_parameters.loss());
   net->export_weights(model);
 
   nlohmann::json final_losses{{"train_loss", last_train_loss}};
-  if (best_batch > 0)
-    final_losses.update({{"best_batch", best_batch}, {"validation_loss", best_loss}});
+  if (best_parameters.step() > 0)
+    final_losses.update(
+        {{"best_batch", best_parameters.step()}, {"validation_loss", best_parameters.loss()}});
   const double seconds = watch.elapsed_s();
   model.training_info = {{"batches", params.batches},
                          {"batch_size", params.batch_size},
