@@ -92,6 +92,14 @@ struct PointMaterial {
 // thread; the grid must not change while it is in use.
 class MaterialLookup {
  public:
+  // The grid voxel the last point lay in, and the one segment it and its 26 neighbours hold
+  // (0: none), or kMixed.
+  struct VoxelSegment {
+    static constexpr int kMixed = -1;
+    Eigen::Vector3i voxel = Eigen::Vector3i::Constant(std::numeric_limits<int>::min());
+    int segment = 0;
+  };
+
   MaterialLookup(const ObservationGrid& grid, const SpecularEstimator& materials,
                  float albedo_smoothing = 0)
       : grid_(grid), materials_(materials), albedo_smoothing_(albedo_smoothing) {}
@@ -103,6 +111,7 @@ class MaterialLookup {
   float albedo_smoothing_;
   RefinedNeighbourhood around_;
   ObservationGrid::BlockCache blocks_;  // the grid blocks found last
+  VoxelSegment last_voxel_;
 };
 
 MaterialMaps render_material_maps(const fusion::SurfaceView& surface, const Pose& camera_to_world,

@@ -249,6 +249,63 @@ TEST(MaterialMaps, SegmentsRefinedAlbedoStandsWithoutVoxelsAndAKeptLookupAgreesW
   EXPECT_GT(missing, 3);
 }
 
+// A concave right-angled corner seen from in front, as a room's: two faces meeting along
+// y = 7 mm, z = 1.01 m, each at 45 degrees to the camera's axis (z = 1.01 - |y - 7 mm|), and the
+// observation voxels labelled 3 where their surface point lies above the corner, 5 below. The
+// voxels along the corner hold both faces and one label: the points of the other face in them
+// take their own face's label; points away from the corner keep their voxel's.
+TEST(MaterialMaps, PointsOfTwoSurfacesInOneVoxelTakeTheLabelOfTheirOwn) {
+  constexpr float kCornerY = 0.007f, kCornerZ = 1.01f;
+  fusion::VolumeParams volume;
+  volume.block_capacity = 1 << 12;
+  fusion::TsdfVolume geometry(volume);
+  ObservationGrid grid(ObservationGridParams{.voxel_capacity = 1 << 14});
+  const Intrinsics camera{160, 120, 240.0, 240.0, 79.5, 59.5};
+  ImageF depth(160, 120, 1);
+  for (int y = 0; y < 120; ++y)
+    for (int x = 0; x < 160; ++x) {
+      const float slope = float((y - camera.cy) / camera.fy);   // y / z along the pixel's ray
+      const float below = (kCornerZ + kCornerY) / (1 + slope);  // where y > kCornerY
+      const float above = (kCornerZ - kCornerY) / (1 - slope);
+      depth.at(x, y, 0) = slope * below >= kCornerY ? below : above;
+    }
+  fusion::VisibleBlocks blocks;
+  const ImageF colour(160, 120, 3, 0.2f);
+  fusion::integrate(geometry, depth, colour, camera, Pose::Identity(), blocks);
+  for (int frame = 0; frame < 2; ++frame)
+    grid.collect(depth, colour, camera, Pose::Identity(), 1.0f, geometry, frame);
+  const std::vector<VisibleVoxel> visible = grid.visible();
+  ASSERT_GT(visible.size(), 100u);
+  for (const VisibleVoxel& seen : visible)
+    grid.segment(seen.voxel) = grid.position(seen.voxel).y() < kCornerY ? 3 : 5;
+
+  const HemiCnn network;
+  SpecularParams params;
+  params.fit_lobe = false;
+  SpecularEstimator estimator(network, params);
+  MaterialLookup lookup(grid, estimator);
+  // Points on either face up to 3 cm (along y) from the corner.
+  int in_other_voxel = 0, wrong = 0, points = 0;
+  for (float along = 0.0005f; along < 0.03f; along += 0.0005f)
+    for (float x = -0.05f; x <= 0.05f; x += 0.0037f)
+      for (const int face : {3, 5}) {
+        const Eigen::Vector3f p(x, kCornerY + (face == 3 ? -along : along), kCornerZ - along);
+        const int v = grid.find(p);
+        if (v < 0 || grid.segment(v) <= 0) continue;
+        PointMaterial material;
+        lookup(p, material);  // no material yet: false, with the segment found
+        ++points;
+        in_other_voxel += grid.segment(v) != face;
+        wrong += material.segment != face;
+        if (along > 0.02f) {
+          EXPECT_EQ(material.segment, face) << p.transpose();
+        }
+      }
+  EXPECT_GT(points, 1000);
+  EXPECT_GT(in_other_voxel, 50);
+  EXPECT_LT(wrong, in_other_voxel / 2);
+}
+
 // (The specular stage's sampling, here for the Wall.) A segment with fewer qualifying voxels
 // than the network's 25 branches repeats them, from min_distinct_voxels on.
 TEST(SpecularEstimator, SmallSegmentsRepeatTheirVoxelsToFillTheBranches) {
