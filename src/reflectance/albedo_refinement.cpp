@@ -29,13 +29,12 @@ struct CompareExchange {
   std::uint8_t low = 0, high = 0;
   bool keeps_low = true, keeps_high = true;
 };
-template <std::size_t kPairs>
 struct Network {
-  std::array<CompareExchange, kPairs> pairs{};
+  std::array<CompareExchange, kNetworkPairs> pairs{};
   std::size_t count = 0;
 };
-constexpr Network<kNetworkPairs> merge_sort_network() {
-  Network<kNetworkPairs> network;
+constexpr Network merge_sort_network() {
+  Network network;
   for (int p = 1; p < kNetworkSize; p *= 2)
     for (int k = p; k >= 1; k /= 2)
       for (int j = k % p; j + k < kNetworkSize; j += 2 * k)
@@ -51,31 +50,24 @@ constexpr Network<kNetworkPairs> merge_sort_network() {
 // observations when the 32 - n padding values are split evenly between -inf and +inf (the odd
 // one +inf): 157 of the 191 steps remain, with 284 of their 382 min / max.
 constexpr int kMiddle = kNetworkSize / 2;
-constexpr Network<kNetworkPairs> middle_network_reversed() {
-  const Network<kNetworkPairs> sort = merge_sort_network();
+constexpr Network middle_network() {
+  const Network sort = merge_sort_network();
   std::array<bool, kNetworkSize> read{};
   read.at(kMiddle - 1) = read.at(kMiddle) = true;
-  Network<kNetworkPairs> reversed;
+  Network middle;
   for (std::size_t i = sort.count; i-- > 0;) {
     CompareExchange step = sort.pairs.at(i);
     step.keeps_low = read.at(step.low);
     step.keeps_high = read.at(step.high);
     if (!step.keeps_low && !step.keeps_high) continue;
     read.at(step.low) = read.at(step.high) = true;
-    reversed.pairs.at(reversed.count++) = step;
+    middle.pairs.at(middle.count++) = step;
   }
-  return reversed;
+  std::reverse(middle.pairs.begin(), middle.pairs.begin() + middle.count);  // back in order
+  return middle;
 }
-constexpr std::size_t kMiddlePairs = middle_network_reversed().count;
-static_assert(merge_sort_network().count == kNetworkPairs && kMiddlePairs == 157);
-constexpr std::array<CompareExchange, kMiddlePairs> middle_network() {
-  const Network<kNetworkPairs> reversed = middle_network_reversed();
-  std::array<CompareExchange, kMiddlePairs> steps{};
-  for (std::size_t i = 0; i < kMiddlePairs; ++i)
-    steps.at(i) = reversed.pairs.at(kMiddlePairs - 1 - i);
-  return steps;
-}
-constexpr std::array<CompareExchange, kMiddlePairs> kMiddleNetwork = middle_network();
+constexpr Network kMiddleNetwork = middle_network();
+static_assert(merge_sort_network().count == kNetworkPairs && kMiddleNetwork.count == 157);
 
 // (low, high) = (low < high ? low : high, low < high ? high : low), lane by lane, each only
 // where the step keeps it. minps(a, b) and maxps(b, a) are exactly those selections, NaN and
@@ -114,12 +106,12 @@ Eigen::Vector3f channel_medians(Channels* values, int n) {
     std::fill(values + n, values + n + below, Channels{} - INFINITY);
     std::fill(values + n + below, values + kNetworkSize, Channels{} + INFINITY);
     [&]<std::size_t... kIndex>(std::index_sequence<kIndex...>) {
-      (compare_exchange<kMiddleNetwork[kIndex]>(values), ...);
+      (compare_exchange<kMiddleNetwork.pairs[kIndex]>(values), ...);
     }
-    (std::make_index_sequence<kMiddlePairs>{});
+    (std::make_index_sequence<kMiddleNetwork.count>{});
+    // The n values now lie sorted from `below` on, their middle on kMiddle - 1 and kMiddle.
     for (int c = 0; c < 3; ++c)
-      median[c] = n % 2 == 1 ? values[kMiddle - 1][c]
-                             : 0.5f * (values[kMiddle - 1][c] + values[kMiddle][c]);
+      median[c] = median_of_sorted([&](int j) { return values[below + j][c]; }, n);
     return median;
   }
   std::array<float, kMaxObservationsPerVoxel> channel;

@@ -34,16 +34,19 @@ TEST(MaterialMaps, ShadingIsEquationSixSummedOverTheLights) {
 
 // Observation voxels (2 cm) of a wall at z = 1.005 m, inside one layer of them (not on a voxel
 // face), all in segment 3 with a refined albedo set by `albedo_at` of their surface point, and
-// reliable where `reliable_at` says so (everywhere by default).
+// reliable where `reliable_at` says so (everywhere by default). Or of the surface of any depth
+// image, seen `frames` times from the origin.
 class Wall {
  public:
-  Wall() : geometry_(volume_params()), grid_(ObservationGridParams{.voxel_capacity = 1 << 14}) {
-    // 4-pixel TSDF allocation stride = 3.3 cm < one 4 cm block at 1 m: no block rows missing.
-    const Intrinsics camera{80, 60, 120.0, 120.0, 39.5, 29.5};
+  // 4-pixel TSDF allocation stride = 3.3 cm < one 4 cm block at 1 m: no block rows missing.
+  Wall() : Wall({80, 60, 120.0, 120.0, 39.5, 29.5}, ImageF(80, 60, 1, 1.005f)) {}
+  Wall(const Intrinsics& camera, const ImageF& depth, int frames = 1)
+      : geometry_(volume_params()), grid_(ObservationGridParams{.voxel_capacity = 1 << 14}) {
     fusion::VisibleBlocks blocks;
-    const ImageF depth(80, 60, 1, 1.005f), colour(80, 60, 3, 0.2f);
+    const ImageF colour(depth.width(), depth.height(), 3, 0.2f);
     fusion::integrate(geometry_, depth, colour, camera, Pose::Identity(), blocks);
-    visible_ = grid_.collect(depth, colour, camera, Pose::Identity(), 1.0f, geometry_, 0);
+    for (int frame = 0; frame < frames; ++frame)
+      visible_ = grid_.collect(depth, colour, camera, Pose::Identity(), 1.0f, geometry_, frame);
   }
   template <class AlbedoAt, class ReliableAt = bool (*)(const Eigen::Vector3f&)>
   ObservationGrid& with_albedo(
@@ -256,10 +259,6 @@ TEST(MaterialMaps, SegmentsRefinedAlbedoStandsWithoutVoxelsAndAKeptLookupAgreesW
 // take their own face's label; points away from the corner keep their voxel's.
 TEST(MaterialMaps, PointsOfTwoSurfacesInOneVoxelTakeTheLabelOfTheirOwn) {
   constexpr float kCornerY = 0.007f, kCornerZ = 1.01f;
-  fusion::VolumeParams volume;
-  volume.block_capacity = 1 << 12;
-  fusion::TsdfVolume geometry(volume);
-  ObservationGrid grid(ObservationGridParams{.voxel_capacity = 1 << 14});
   const Intrinsics camera{160, 120, 240.0, 240.0, 79.5, 59.5};
   ImageF depth(160, 120, 1);
   for (int y = 0; y < 120; ++y)
@@ -269,14 +268,10 @@ TEST(MaterialMaps, PointsOfTwoSurfacesInOneVoxelTakeTheLabelOfTheirOwn) {
       const float above = (kCornerZ - kCornerY) / (1 - slope);
       depth.at(x, y, 0) = slope * below >= kCornerY ? below : above;
     }
-  fusion::VisibleBlocks blocks;
-  const ImageF colour(160, 120, 3, 0.2f);
-  fusion::integrate(geometry, depth, colour, camera, Pose::Identity(), blocks);
-  for (int frame = 0; frame < 2; ++frame)
-    grid.collect(depth, colour, camera, Pose::Identity(), 1.0f, geometry, frame);
-  const std::vector<VisibleVoxel> visible = grid.visible();
-  ASSERT_GT(visible.size(), 100u);
-  for (const VisibleVoxel& seen : visible)
+  Wall corner(camera, depth, 2);
+  ObservationGrid& grid = corner.grid();
+  ASSERT_GT(corner.voxels(), 100u);
+  for (const VisibleVoxel& seen : corner.visible())
     grid.segment(seen.voxel) = grid.position(seen.voxel).y() < kCornerY ? 3 : 5;
 
   const HemiCnn network;
