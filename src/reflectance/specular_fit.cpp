@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "reflectance/light_incidence.h"
 #include "render/ward.h"
@@ -9,19 +10,27 @@
 namespace glint::reflectance {
 namespace {
 
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
 // The fit's data in structure-of-arrays form. A term is one (observation, light) pair whose
 // lobe can be non-zero: its tan^2(theta_h) and L_l cos(theta_i) / (4 pi sqrt(cos_i cos_o)) per
 // channel, so that the lobe sum of eq. (6) at roughness alpha is
 //   G_k = sum over k's terms of weight * exp(-tan2 / alpha^2) / alpha^2      (eqs 3-4)
+// A voxel's observations with no clipped channel are data; those with one are bounds: the
+// radiance of a clipped channel was at least the clip level, so the model's prediction there
+// (the voxel's diffuse term, fitted from its data, plus ks G_k) should reach it. A sharp
+// highlight's peak clips, and without its bounds the fit saw only the peak's flanks and took
+// them for a weak lobe (the yellow bunny: ks 0.05 against 0.2).
 class LobeProblem {
  public:
   LobeProblem(const std::vector<FitVoxel>& voxels, const std::vector<render::PointLight>& lights,
               const SpecularFitParams& params);
 
-  int observations() const { return int(centred_colour_.size()); }
+  int observations() const { return data_; }
   double variation() const { return variation_.sum(); }
 
-  // The squared residual of the best ks at `alpha` (summed over channels); the slope into *ks.
+  // The squared residual of the best ks at `alpha` (summed over channels; a bound the lobe
+  // falls short of counts its shortfall squared); the slope into *ks.
   double residual(float alpha, Eigen::Vector3f* ks) const;
 
  private:
@@ -31,10 +40,15 @@ class LobeProblem {
   std::vector<float> tan2_;
   std::vector<Eigen::Vector3f> weight_;
   std::vector<int> term_observation_;
-  std::vector<Eigen::Vector3f> centred_colour_;  // B_vk minus the voxel's mean
-  std::vector<int> voxel_end_;                   // observations [previous end, end) per voxel
-  Eigen::Vector3d variation_ = Eigen::Vector3d::Zero();  // sum of centred_colour^2
+  // Per observation: a datum's colour minus its voxel's mean datum; a bound's clip level minus
+  // that mean in its clipped channels, NaN in the others.
+  std::vector<Eigen::Vector3f> centred_colour_;
+  // Per voxel: its data are observations [previous end, data end), its bounds [data end, end).
+  std::vector<int> voxel_data_end_, voxel_end_;
+  int data_ = 0;
+  Eigen::Vector3d variation_ = Eigen::Vector3d::Zero();  // sum of the data's centred_colour^2
   std::vector<Incidence> lit_;                           // scratch of add_voxel()
+  std::vector<int> bounds_;                              // scratch of add_voxel()
   mutable std::vector<float> factor_;                    // per term, at the alpha being evaluated
   mutable std::vector<Eigen::Vector3f> lobe_sum_;
 };
@@ -43,7 +57,12 @@ LobeProblem::LobeProblem(const std::vector<FitVoxel>& voxels,
                          const std::vector<render::PointLight>& lights,
                          const SpecularFitParams& params) {
   for (const FitVoxel& voxel : voxels) add_voxel(voxel, lights, params);
-  for (const Eigen::Vector3f& c : centred_colour_) variation_ += c.cast<double>().cwiseAbs2();
+  int begin = 0;
+  for (std::size_t v = 0; v < voxel_end_.size(); ++v) {
+    for (int k = begin; k < voxel_data_end_[v]; ++k)
+      variation_ += centred_colour_[k].cast<double>().cwiseAbs2();
+    begin = voxel_end_[v];
+  }
   lobe_sum_.resize(centred_colour_.size());
   factor_.resize(tan2_.size());
 }
@@ -57,15 +76,9 @@ void LobeProblem::add_voxel(const FitVoxel& voxel, const std::vector<render::Poi
     if (const Incidence in = incidence(light, voxel.position, voxel.normal);
         in.cosine > render::kGrazingCosine)
       lit_.push_back(in);
-  const int first = observations();
-  const std::size_t first_term = tan2_.size();
-  Eigen::Vector3f mean = Eigen::Vector3f::Zero();
-  for (int k = 0; k < std::min(voxel.count, kMaxObservationsPerVoxel); ++k) {
-    const Observation& o = voxel.observations[k];
-    const Eigen::Vector3f direction = o.direction(), colour = o.colour();
-    const float cos_o = voxel.normal.dot(direction);
-    if (!(cos_o > 0.0f) || !(colour.maxCoeff() < params.saturated_radiance)) continue;
-    const int index = observations();
+  const std::size_t first = centred_colour_.size(), first_term = tan2_.size();
+  const auto add_terms = [&](const Eigen::Vector3f& direction, float cos_o) {
+    const int index = int(centred_colour_.size());
     if (cos_o > render::kGrazingCosine)  // a grazing view has no lobe term (render/ward.h)
       for (const Incidence& in : lit_) {
         const float tan2 = render::ward_half_angle_tan2(voxel.normal, in.direction, direction);
@@ -74,20 +87,46 @@ void LobeProblem::add_voxel(const FitVoxel& voxel, const std::vector<render::Poi
         weight_.push_back(in.irradiance / (4.0f * float(M_PI) * std::sqrt(in.cosine * cos_o)));
         term_observation_.push_back(index);
       }
+  };
+  // The data first, then the bounds.
+  bounds_.clear();
+  Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+  const int count = std::min(voxel.count, kMaxObservationsPerVoxel);
+  for (int k = 0; k < count; ++k) {
+    const Observation& o = voxel.observations[k];
+    const float cos_o = voxel.normal.dot(o.direction());
+    if (!(cos_o > 0.0f)) continue;
+    const Eigen::Vector3f colour = o.colour();
+    if (!(colour.maxCoeff() < params.saturated_radiance)) {
+      if (params.clipped_as_bounds) bounds_.push_back(k);
+      continue;
+    }
+    add_terms(o.direction(), cos_o);
     centred_colour_.push_back(colour);
     mean += colour;
   }
-  const int added = observations() - first;
-  if (added < 2) {  // one observation has no variation to explain
+  const int data = int(centred_colour_.size() - first);
+  if (data < 2) {  // one observation has no variation to explain, nor a diffuse term to fit
     centred_colour_.resize(first);
     tan2_.resize(first_term);
     weight_.resize(first_term);
     term_observation_.resize(first_term);
     return;
   }
-  mean /= float(added);
-  for (int k = first; k < observations(); ++k) centred_colour_[k] -= mean;
-  voxel_end_.push_back(observations());
+  mean /= float(data);
+  for (std::size_t k = first; k < centred_colour_.size(); ++k) centred_colour_[k] -= mean;
+  data_ += data;
+  voxel_data_end_.push_back(int(centred_colour_.size()));
+  for (const int k : bounds_) {
+    const Observation& o = voxel.observations[k];
+    add_terms(o.direction(), voxel.normal.dot(o.direction()));
+    Eigen::Vector3f bound;
+    for (int c = 0; c < 3; ++c)
+      bound[c] =
+          o.colour()[c] >= params.saturated_radiance ? params.saturated_radiance - mean[c] : kNaN;
+    centred_colour_.push_back(bound);
+  }
+  voxel_end_.push_back(int(centred_colour_.size()));
 }
 
 double LobeProblem::residual(float alpha, Eigen::Vector3f* ks) const {
@@ -95,15 +134,18 @@ double LobeProblem::residual(float alpha, Eigen::Vector3f* ks) const {
   std::fill(lobe_sum_.begin(), lobe_sum_.end(), Eigen::Vector3f::Zero());
   for (std::size_t t = 0; t < tan2_.size(); ++t)
     lobe_sum_[term_observation_[t]] += weight_[t] * factor_[t];
-  // Per channel: the slope of the centred colours over the centred lobe sums.
+  // Per channel: the slope of the data's centred colours over their centred lobe sums; every
+  // lobe sum is centred on its voxel's data mean (lobe_sum_ holds them centred from here on).
   Eigen::Vector3d covariance = Eigen::Vector3d::Zero(), lobe_variation = Eigen::Vector3d::Zero();
   int begin = 0;
-  for (const int end : voxel_end_) {
+  for (std::size_t v = 0; v < voxel_end_.size(); ++v) {
+    const int data_end = voxel_data_end_[v], end = voxel_end_[v];
     Eigen::Vector3f mean = Eigen::Vector3f::Zero();
-    for (int k = begin; k < end; ++k) mean += lobe_sum_[k];
-    mean /= float(end - begin);
-    for (int k = begin; k < end; ++k) {
-      const Eigen::Vector3d g = (lobe_sum_[k] - mean).cast<double>();
+    for (int k = begin; k < data_end; ++k) mean += lobe_sum_[k];
+    mean /= float(data_end - begin);
+    for (int k = begin; k < end; ++k) lobe_sum_[k] -= mean;
+    for (int k = begin; k < data_end; ++k) {
+      const Eigen::Vector3d g = lobe_sum_[k].cast<double>();
       covariance += g.cwiseProduct(centred_colour_[k].cast<double>());
       lobe_variation += g.cwiseAbs2();
     }
@@ -112,10 +154,34 @@ double LobeProblem::residual(float alpha, Eigen::Vector3f* ks) const {
   double squared = 0;
   for (int c = 0; c < 3; ++c) {
     // ks >= 0: a lobe that anti-correlates with the observations fits as no lobe.
-    const bool lobe = covariance[c] > 0 && lobe_variation[c] > 0;
-    const double slope = lobe ? covariance[c] / lobe_variation[c] : 0.0;
+    const auto slope_of = [](double covariance, double variation) {
+      return covariance > 0 && variation > 0 ? covariance / variation : 0.0;
+    };
+    double slope = slope_of(covariance[c], lobe_variation[c]);
+    // The bounds the lobe falls short of join the data (each a squared shortfall, linear in ks
+    // like a datum), until the set of those stays the same (a few rounds: raising ks only
+    // releases bounds).
+    double bound_covariance = 0, bound_variation = 0, bound_squares = 0;
+    for (int round = 0; round < 4; ++round) {
+      double cov = 0, var = 0, squares = 0;
+      for (std::size_t v = 0; v < voxel_end_.size(); ++v) {
+        for (int k = voxel_data_end_[v]; k < voxel_end_[v]; ++k) {
+          const double bound = centred_colour_[k][c], g = lobe_sum_[k][c];
+          if (!(bound > slope * g)) continue;  // reached (or not clipped in this channel)
+          cov += bound * g;
+          var += g * g;
+          squares += bound * bound;
+        }
+      }
+      const bool same = cov == bound_covariance && var == bound_variation;
+      bound_covariance = cov, bound_variation = var, bound_squares = squares;
+      if (same) break;
+      slope = slope_of(covariance[c] + cov, lobe_variation[c] + var);
+    }
     (*ks)[c] = float(slope);
-    squared += variation_[c] - slope * covariance[c];
+    // sum (x - slope g)^2 over the data and the active bounds.
+    squared += variation_[c] + bound_squares - 2 * slope * (covariance[c] + bound_covariance) +
+               slope * slope * (lobe_variation[c] + bound_variation);
   }
   return squared;
 }

@@ -7,8 +7,10 @@
 // mean observation removes the unknown, spatially varying kd_v. What is left is linear in ks:
 // for a given alpha, ks per channel is a least-squares slope in closed form, and alpha is the
 // one-dimensional minimiser of the remaining squared error (a log-spaced scan, then golden-
-// section search). The HemiCNN's estimate stands where the lobe explains too little of the
-// observations' variation (a matte segment, or too few views of its highlights).
+// section search). Observations with a clipped channel bound the prediction there from below
+// (a censored fit): a bound the lobe falls short of adds its shortfall squared. The HemiCNN's
+// estimate stands where the lobe explains too little of the observations' variation (a matte
+// segment, too few views of its highlights, or a lobe that falls short of the clipped ones).
 #include <Eigen/Core>
 #include <limits>
 #include <optional>
@@ -28,8 +30,11 @@ struct SpecularFitParams {
   // their voxels' means, or the fit is not used.
   float min_explained = 0.2f;
   // Observations with a channel at or above this radiance are clipped by the sensor (a
-  // highlight's peak often is) and stay out of the fit; the pipeline sets it from the exposure.
+  // highlight's peak often is): bounds, not data. The pipeline sets it from the exposure.
   float saturated_radiance = std::numeric_limits<float>::infinity();
+  // Clipped observations as lower bounds of the prediction in their clipped channels (false:
+  // left out of the fit altogether).
+  bool clipped_as_bounds = true;
 };
 
 // One voxel's stored observations and its surface point.
@@ -43,8 +48,9 @@ struct FitVoxel {
 struct SpecularFit {
   Eigen::Vector3f ks = Eigen::Vector3f::Zero();  // per channel, >= 0
   float alpha = 0.1f;
-  float explained = 0.0f;  // 1 - residual / variation about the voxel means, in [0, 1]
-  int observations = 0;    // observations from above the surface that entered the fit
+  // 1 - residual (bounds' shortfalls included) / variation about the voxel means, in [0, 1]
+  float explained = 0.0f;
+  int observations = 0;  // data (unclipped observations from above the surface) in the fit
 };
 
 // Fits (ks, alpha) to the observations of `voxels` (those from above the surface and not

@@ -102,6 +102,56 @@ TEST(SpecularFit, LeavesSaturatedObservationsOut) {
   EXPECT_TRUE(fit->ks.isApprox(ks, 0.03f)) << fit->ks.transpose();
 }
 
+// The segment of render_segment() under four times brighter lights, clipped at 1 (most
+// highlight peaks clip), with every voxel's normal tilted `off_deg` in a random direction, as a
+// plane fit's normals are on a curved object.
+Segment clipped_segment_with_normal_error(const Eigen::Vector3f& ks, float alpha,
+                                          const std::vector<render::PointLight>& lights,
+                                          float off_deg) {
+  Segment segment = render_segment(ks, alpha, lights, 1.0f);
+  std::mt19937 random(11);
+  std::uniform_real_distribution<float> angle(0.0f, float(2 * M_PI));
+  const float off = float(off_deg * M_PI / 180);
+  for (FitVoxel& voxel : segment.voxels) {
+    const Eigen::Vector3f t1 = voxel.normal.unitOrthogonal(), t2 = voxel.normal.cross(t1);
+    const float phi = angle(random);
+    voxel.normal =
+        std::cos(off) * voxel.normal + std::sin(off) * (std::cos(phi) * t1 + std::sin(phi) * t2);
+  }
+  return segment;
+}
+
+TEST(SpecularFit, ClippedHighlightsBoundTheLobeFromBelow) {
+  auto lights = two_lights();
+  for (auto& light : lights) light.intensity *= 4.0f;
+  const Eigen::Vector3f ks(0.2f, 0.2f, 0.2f);
+  const float alpha = 0.08f;
+  SpecularFitParams bounded;
+  bounded.saturated_radiance = 0.99f;
+  SpecularFitParams left_out = bounded;
+  left_out.clipped_as_bounds = false;
+
+  // Normals 1 degree off: the unclipped flanks alone take the highlights for a weaker lobe; the
+  // clipped peaks, which the lobe must reach, pull ks back up.
+  const Segment slightly_off = clipped_segment_with_normal_error(ks, alpha, lights, 1.0f);
+  const auto with_bounds = fit_specular(slightly_off.voxels, lights, bounded);
+  const auto without = fit_specular(slightly_off.voxels, lights, left_out);
+  ASSERT_TRUE(with_bounds.has_value());
+  ASSERT_TRUE(without.has_value());
+  EXPECT_LT(without->ks.x(), 0.65f * ks.x()) << "flanks alone: too weak a lobe";
+  EXPECT_TRUE(with_bounds->ks.isApprox(ks, 0.15f)) << with_bounds->ks.transpose();
+  EXPECT_EQ(with_bounds->observations, without->observations) << "bounds are not data";
+
+  // Normals 2 degrees off: the flanks alone give a third of the true ks and look like a good fit
+  // (explaining 60 % of the variation); no lobe of the searched range reaches the clipped peaks
+  // and fits the flanks, so with the bounds there is no fit, and the network's estimate stands.
+  const Segment off = clipped_segment_with_normal_error(ks, alpha, lights, 2.0f);
+  const auto misled = fit_specular(off.voxels, lights, left_out);
+  ASSERT_TRUE(misled.has_value());
+  EXPECT_LT(misled->ks.x(), 0.5f * ks.x());
+  EXPECT_FALSE(fit_specular(off.voxels, lights, bounded).has_value());
+}
+
 TEST(SpecularFit, AMatteOrNoisySegmentHasNoFit) {
   const auto lights = two_lights();
   // Diffuse: every voxel's observations are equal, there is nothing to explain.
