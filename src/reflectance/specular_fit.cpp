@@ -159,12 +159,12 @@ double LobeProblem::residual(float alpha, Eigen::Vector3f* ks) const {
     };
     double slope = slope_of(covariance[c], lobe_variation[c]);
     // The bounds the lobe falls short of join the data (each a squared shortfall, linear in ks
-    // like a datum), until the set of those stays the same (a few rounds: raising ks only
-    // releases bounds).
+    // like a datum), refitting until that set stays the same (at most four rounds). The sums
+    // are those of the set at the final slope, so the residual is the censored objective there.
     double bound_covariance = 0, bound_variation = 0, bound_squares = 0;
-    for (int round = 0; round < 4; ++round) {
+    for (int round = 0;; ++round) {
       double cov = 0, var = 0, squares = 0;
-      for (std::size_t v = 0; v < voxel_end_.size(); ++v) {
+      for (std::size_t v = 0; v < voxel_end_.size(); ++v)
         for (int k = voxel_data_end_[v]; k < voxel_end_[v]; ++k) {
           const double bound = centred_colour_[k][c], g = lobe_sum_[k][c];
           if (!(bound > slope * g)) continue;  // reached (or not clipped in this channel)
@@ -172,10 +172,9 @@ double LobeProblem::residual(float alpha, Eigen::Vector3f* ks) const {
           var += g * g;
           squares += bound * bound;
         }
-      }
-      const bool same = cov == bound_covariance && var == bound_variation;
+      const bool same = round > 0 && cov == bound_covariance && var == bound_variation;
       bound_covariance = cov, bound_variation = var, bound_squares = squares;
-      if (same) break;
+      if (same || round == 3) break;
       slope = slope_of(covariance[c] + cov, lobe_variation[c] + var);
     }
     (*ks)[c] = float(slope);
