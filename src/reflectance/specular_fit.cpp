@@ -48,7 +48,7 @@ class LobeProblem {
   int data_ = 0;
   Eigen::Vector3d variation_ = Eigen::Vector3d::Zero();  // sum of the data's centred_colour^2
   std::vector<Incidence> lit_;                           // scratch of add_voxel()
-  std::vector<int> bounds_;                              // scratch of add_voxel()
+  std::vector<int> clipped_;                             // scratch of add_voxel()
   mutable std::vector<float> factor_;                    // per term, at the alpha being evaluated
   mutable std::vector<Eigen::Vector3f> lobe_sum_;
 };
@@ -57,12 +57,6 @@ LobeProblem::LobeProblem(const std::vector<FitVoxel>& voxels,
                          const std::vector<render::PointLight>& lights,
                          const SpecularFitParams& params) {
   for (const FitVoxel& voxel : voxels) add_voxel(voxel, lights, params);
-  int begin = 0;
-  for (std::size_t v = 0; v < voxel_end_.size(); ++v) {
-    for (int k = begin; k < voxel_data_end_[v]; ++k)
-      variation_ += centred_colour_[k].cast<double>().cwiseAbs2();
-    begin = voxel_end_[v];
-  }
   lobe_sum_.resize(centred_colour_.size());
   factor_.resize(tan2_.size());
 }
@@ -89,7 +83,7 @@ void LobeProblem::add_voxel(const FitVoxel& voxel, const std::vector<render::Poi
       }
   };
   // The data first, then the bounds.
-  bounds_.clear();
+  clipped_.clear();
   Eigen::Vector3f mean = Eigen::Vector3f::Zero();
   const int count = std::min(voxel.count, kMaxObservationsPerVoxel);
   for (int k = 0; k < count; ++k) {
@@ -98,7 +92,7 @@ void LobeProblem::add_voxel(const FitVoxel& voxel, const std::vector<render::Poi
     if (!(cos_o > 0.0f)) continue;
     const Eigen::Vector3f colour = o.colour();
     if (!(colour.maxCoeff() < params.saturated_radiance)) {
-      if (params.clipped_as_bounds) bounds_.push_back(k);
+      if (params.clipped_as_bounds) clipped_.push_back(k);
       continue;
     }
     add_terms(o.direction(), cos_o);
@@ -114,10 +108,13 @@ void LobeProblem::add_voxel(const FitVoxel& voxel, const std::vector<render::Poi
     return;
   }
   mean /= float(data);
-  for (std::size_t k = first; k < centred_colour_.size(); ++k) centred_colour_[k] -= mean;
+  for (std::size_t k = first; k < centred_colour_.size(); ++k) {
+    centred_colour_[k] -= mean;
+    variation_ += centred_colour_[k].cast<double>().cwiseAbs2();
+  }
   data_ += data;
   voxel_data_end_.push_back(int(centred_colour_.size()));
-  for (const int k : bounds_) {
+  for (const int k : clipped_) {
     const Observation& o = voxel.observations[k];
     add_terms(o.direction(), voxel.normal.dot(o.direction()));
     Eigen::Vector3f bound;
