@@ -228,16 +228,22 @@ int segment_at(const ObservationGrid& grid, const Eigen::Vector3f& p,
     return around.grid_voxels[std::size_t((d.z() * 4 + d.y()) * 4 + d.x())];
   };
   const auto segment_of = [&](int v) { return v >= 0 ? std::max(grid.segment(v), 0) : 0; };
-  if (last.voxel != centre) {
-    last.voxel = centre;
-    last.segment = 0;
+  const auto for_each_of_27 = [&](auto&& visit) {  // p's voxel and its 26 neighbours
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
-          const int segment = segment_of(voxel_at(centre + Eigen::Vector3i(dx, dy, dz)));
-          if (segment > 0 && last.segment != segment)
-            last.segment = last.segment == 0 ? segment : MaterialLookup::VoxelSegment::kMixed;
+          const Eigen::Vector3i voxel = centre + Eigen::Vector3i(dx, dy, dz);
+          visit(voxel, voxel_at(voxel));
         }
+  };
+  if (last.voxel != centre) {
+    last.voxel = centre;
+    last.segment = 0;
+    for_each_of_27([&](const Eigen::Vector3i&, int n) {
+      const int segment = segment_of(n);
+      if (segment > 0 && last.segment != segment)
+        last.segment = last.segment == 0 ? segment : MaterialLookup::VoxelSegment::kMixed;
+    });
   }
   if (last.segment != MaterialLookup::VoxelSegment::kMixed) return last.segment;
   const auto plane_distance = [&](int v) {
@@ -247,17 +253,13 @@ int segment_at(const ObservationGrid& grid, const Eigen::Vector3f& p,
   if (segment_of(v) > 0 && plane_distance(v) <= kOnVoxelSurface * size) return grid.segment(v);
   int best = 0;
   float best_plane = INFINITY, best_centre = INFINITY;
-  for (int dz = -1; dz <= 1; ++dz)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const Eigen::Vector3i voxel = centre + Eigen::Vector3i(dx, dy, dz);
-        const int n = voxel_at(voxel);
-        if (segment_of(n) == 0) continue;
-        const float plane = plane_distance(n);
-        const float to_centre = (grid.voxel_centre(voxel) - p).squaredNorm();
-        if (plane < best_plane || (plane == best_plane && to_centre < best_centre))
-          best = grid.segment(n), best_plane = plane, best_centre = to_centre;
-      }
+  for_each_of_27([&](const Eigen::Vector3i& voxel, int n) {
+    if (segment_of(n) == 0) return;
+    const float plane = plane_distance(n);
+    const float to_centre = (grid.voxel_centre(voxel) - p).squaredNorm();
+    if (plane < best_plane || (plane == best_plane && to_centre < best_centre))
+      best = grid.segment(n), best_plane = plane, best_centre = to_centre;
+  });
   return best;
 }
 

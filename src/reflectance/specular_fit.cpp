@@ -45,6 +45,7 @@ class LobeProblem {
   std::vector<Eigen::Vector3f> centred_colour_;
   // Per voxel: its data are observations [previous end, data end), its bounds [data end, end).
   std::vector<int> voxel_data_end_, voxel_end_;
+  std::vector<int> bounds_;  // the bounds' observations, of every voxel
   int data_ = 0;
   Eigen::Vector3d variation_ = Eigen::Vector3d::Zero();  // sum of the data's centred_colour^2
   std::vector<Incidence> lit_;                           // scratch of add_voxel()
@@ -116,11 +117,13 @@ void LobeProblem::add_voxel(const FitVoxel& voxel, const std::vector<render::Poi
   voxel_data_end_.push_back(int(centred_colour_.size()));
   for (const int k : clipped_) {
     const Observation& o = voxel.observations[k];
-    add_terms(o.direction(), voxel.normal.dot(o.direction()));
+    const Eigen::Vector3f direction = o.direction(), colour = o.colour();
+    add_terms(direction, voxel.normal.dot(direction));
     Eigen::Vector3f bound;
     for (int c = 0; c < 3; ++c)
       bound[c] =
-          o.colour()[c] >= params.saturated_radiance ? params.saturated_radiance - mean[c] : kNaN;
+          colour[c] >= params.saturated_radiance ? params.saturated_radiance - mean[c] : kNaN;
+    bounds_.push_back(int(centred_colour_.size()));
     centred_colour_.push_back(bound);
   }
   voxel_end_.push_back(int(centred_colour_.size()));
@@ -161,14 +164,13 @@ double LobeProblem::residual(float alpha, Eigen::Vector3f* ks) const {
     double bound_covariance = 0, bound_variation = 0, bound_squares = 0;
     for (int round = 0;; ++round) {
       double cov = 0, var = 0, squares = 0;
-      for (std::size_t v = 0; v < voxel_end_.size(); ++v)
-        for (int k = voxel_data_end_[v]; k < voxel_end_[v]; ++k) {
-          const double bound = centred_colour_[k][c], g = lobe_sum_[k][c];
-          if (!(bound > slope * g)) continue;  // reached (or not clipped in this channel)
-          cov += bound * g;
-          var += g * g;
-          squares += bound * bound;
-        }
+      for (const int k : bounds_) {
+        const double bound = centred_colour_[k][c], g = lobe_sum_[k][c];
+        if (!(bound > slope * g)) continue;  // reached (or not clipped in this channel)
+        cov += bound * g;
+        var += g * g;
+        squares += bound * bound;
+      }
       const bool same = round > 0 && cov == bound_covariance && var == bound_variation;
       bound_covariance = cov, bound_variation = var, bound_squares = squares;
       if (same || round == 3) break;
