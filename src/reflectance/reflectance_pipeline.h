@@ -61,7 +61,7 @@ struct ReflectanceParams {
   // per cube). Chosen on cubes, which has no texture, so any value smooths (refined-kd L1
   // 0.0169 off, 0.0157 / 0.0152 / 0.0147 / 0.0145 at 0.05 / 0.1 / 0.2 / no range weight); 0.2
   // rather than no limit, to keep textures' contrast. Bunnies and the textured office were held
-  // out (README, "Session of 2026-11-27 (second)").
+  // out (docs/reflectance/history.md, "Session of 2026-11-27 (second)").
   float albedo_smoothing = 0.2f;
   // Radiance = pixel colour / exposure; the lights are in the same radiance units
   // (reflectance/light_estimation.h).
