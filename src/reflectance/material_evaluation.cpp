@@ -93,8 +93,8 @@ Scores score(const ImageF& truth, const ImageF& estimate, const ImageF& mask, co
   // Whole frame, the object alone (zero elsewhere in both images): outside the object the
   // error is zero, and every SSIM window more than its radius away from the object sees two
   // equal zero patches (SSIM 1). So only the object's box grown by twice the radius is
-  // computed: windows within one radius of the box then stay inside the crop, where the
-  // zero-padded border of denoise::ssim would otherwise change their means.
+  // computed: windows within one radius of the box then stay inside the crop, where
+  // denoise::ssim's border (windows cut and renormalised) would otherwise change their means.
   const double frame_pixels = double(truth.width()) * truth.height();
   s.psnr_frame = capped_psnr(squared / (frame_pixels * truth.channels()));
   const Box around = grown(box, 2 * kSsimRadius, truth.width(), truth.height());

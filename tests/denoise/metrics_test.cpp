@@ -75,27 +75,34 @@ TEST(Ssim, ConstantImagesReduceToTheLuminanceTerm) {
   EXPECT_NEAR(ssim(a, b), (expected(0.2f, 0.9f) + expected(0.5f, 0.4f)) / 2, 1e-9);
 }
 
-// Wang et al.'s SSIM written out: Gaussian weights over the window cut to the image.
-double ssim_by_definition(const ImageF& x, const ImageF& y) {
+// Wang et al.'s SSIM written out: Gaussian weights over the window cut to the image, the map
+// averaged over the masked pixels (all without a mask) per channel, then over the channels.
+double ssim_by_definition(const ImageF& x, const ImageF& y, const ImageF* mask = nullptr) {
   double total = 0;
-  for (int py = 0; py < x.height(); ++py) {
-    for (int px = 0; px < x.width(); ++px) {
-      double w_sum = 0, mx = 0, my = 0, xx = 0, yy = 0, xy = 0;
-      for (int qy = std::max(0, py - 5); qy <= std::min(x.height() - 1, py + 5); ++qy) {
-        for (int qx = std::max(0, px - 5); qx <= std::min(x.width() - 1, px + 5); ++qx) {
-          const double d2 = (qx - px) * (qx - px) + (qy - py) * (qy - py);
-          const double w = std::exp(-d2 / (2 * 1.5 * 1.5));
-          const double a = x.at(qx, qy, 0), b = y.at(qx, qy, 0);
-          w_sum += w, mx += w * a, my += w * b, xx += w * a * a, yy += w * b * b, xy += w * a * b;
+  for (int c = 0; c < x.channels(); ++c) {
+    double sum = 0, count = 0;
+    for (int py = 0; py < x.height(); ++py) {
+      for (int px = 0; px < x.width(); ++px) {
+        if (mask != nullptr && mask->at(px, py, 0) <= 0.5f) continue;
+        double w_sum = 0, mx = 0, my = 0, xx = 0, yy = 0, xy = 0;
+        for (int qy = std::max(0, py - 5); qy <= std::min(x.height() - 1, py + 5); ++qy) {
+          for (int qx = std::max(0, px - 5); qx <= std::min(x.width() - 1, px + 5); ++qx) {
+            const double d2 = (qx - px) * (qx - px) + (qy - py) * (qy - py);
+            const double w = std::exp(-d2 / (2 * 1.5 * 1.5));
+            const double a = x.at(qx, qy, c), b = y.at(qx, qy, c);
+            w_sum += w, mx += w * a, my += w * b, xx += w * a * a, yy += w * b * b, xy += w * a * b;
+          }
         }
+        mx /= w_sum, my /= w_sum, xx /= w_sum, yy /= w_sum, xy /= w_sum;
+        const double vx = xx - mx * mx, vy = yy - my * my, cxy = xy - mx * my;
+        sum +=
+            (2 * mx * my + kC1) * (2 * cxy + kC2) / ((mx * mx + my * my + kC1) * (vx + vy + kC2));
+        ++count;
       }
-      mx /= w_sum, my /= w_sum, xx /= w_sum, yy /= w_sum, xy /= w_sum;
-      const double vx = xx - mx * mx, vy = yy - my * my, cxy = xy - mx * my;
-      total +=
-          (2 * mx * my + kC1) * (2 * cxy + kC2) / ((mx * mx + my * my + kC1) * (vx + vy + kC2));
     }
+    total += sum / count;
   }
-  return total / static_cast<double>(x.pixel_count());
+  return total / x.channels();
 }
 
 TEST(Ssim, AgreesWithTheDefinitionOnANoisyPair) {
@@ -107,6 +114,17 @@ TEST(Ssim, AgreesWithTheDefinitionOnANoisyPair) {
   EXPECT_LT(value, 0.95);
   const ImageF noisier = add_noise_in_mask(clean, test::constant(23, 17, 1, 1.f), 0.3, 5);
   EXPECT_LT(ssim(clean, noisier), value);
+}
+
+// Odd sizes, two channels and a ragged mask that reaches the corners: every window cut at
+// one border, at two, or not at all.
+TEST(Ssim, AgreesWithTheDefinitionWithAMaskAndSeveralChannels) {
+  const ImageF clean = test::random_image(23, 17, 2, 7, 0.1f, 0.9f);
+  const ImageF noisy = add_noise_in_mask(clean, test::constant(23, 17, 1, 1.f), 0.15, 8);
+  ImageF mask = test::random_image(23, 17, 1, 9);  // about half the pixels > 0.5
+  mask.at(0, 0, 0) = mask.at(22, 16, 0) = 1.f;
+  EXPECT_NEAR(ssim(clean, noisy, &mask), ssim_by_definition(clean, noisy, &mask), 1e-12);
+  EXPECT_NEAR(ssim(clean, noisy), ssim_by_definition(clean, noisy), 1e-12);
 }
 
 TEST(Ssim, MaskedAveragesOnlyTheMaskedPixels) {
