@@ -180,23 +180,41 @@ int ObservationGrid::find_voxel(const Eigen::Vector3i& voxel, BlockCache* cache)
 
 void ObservationGrid::find_voxels(const Eigen::Vector3i& first, int n, int* voxels,
                                   BlockCache* cache) const {
-  std::fill_n(voxels, n * n * n, -1);
-  const Eigen::Vector3i last = first + Eigen::Vector3i::Constant(n - 1);
-  const Eigen::Vector3i first_block = floor_div(first, side_), last_block = floor_div(last, side_);
-  for (int bz = first_block.z(); bz <= last_block.z(); ++bz)
-    for (int by = first_block.y(); by <= last_block.y(); ++by)
-      for (int bx = first_block.x(); bx <= last_block.x(); ++bx) {
-        const int index = find_block({bx, by, bz}, cache);
-        if (index < 0) continue;
-        const Eigen::Vector3i origin = Eigen::Vector3i(bx, by, bz) * side_;
-        // The block's voxels within the range.
-        const Eigen::Vector3i low = origin.cwiseMax(first);
-        const Eigen::Vector3i high = (origin + Eigen::Vector3i::Constant(side_ - 1)).cwiseMin(last);
-        for (int z = low.z(); z <= high.z(); ++z)
-          for (int y = low.y(); y <= high.y(); ++y)
-            for (int x = low.x(); x <= high.x(); ++x)
-              voxels[((z - first.z()) * n + (y - first.y())) * n + (x - first.x())] =
-                  voxel_index(index, Eigen::Vector3i(x, y, z) - origin);
+  if (n < 1 || n > kMaxFindVoxelsSide)
+    throw Error("observation grid", "find_voxels",
+                "n must be in 1.." + std::to_string(kMaxFindVoxelsSide));
+  // Per axis and position: the block (counted from first's block) and the voxel's offset in it.
+  // The blocks are looked up once each, then every voxel's index is a sum without a branch
+  // (loops over each block's part of the cube mispredicted their short, varying trip counts).
+  const Eigen::Vector3i first_block = floor_div(first, side_);
+  std::array<std::array<int, kMaxFindVoxelsSide>, 3> block_of, offset;
+  Eigen::Vector3i blocks;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int i = 0; i < n; ++i) {
+      const int local = first[axis] - first_block[axis] * side_ + i;
+      block_of[axis][std::size_t(i)] = local / side_;
+      offset[axis][std::size_t(i)] = local % side_;
+    }
+    blocks[axis] = block_of[axis][std::size_t(n - 1)] + 1;
+  }
+  constexpr int kMaxBlocks = kMaxFindVoxelsSide;  // per axis: n voxels touch at most n blocks
+  std::array<int, kMaxBlocks * kMaxBlocks * kMaxBlocks> base;  // first voxel index, or -1
+  for (int bz = 0; bz < blocks.z(); ++bz)
+    for (int by = 0; by < blocks.y(); ++by)
+      for (int bx = 0; bx < blocks.x(); ++bx) {
+        const int index = find_block(first_block + Eigen::Vector3i(bx, by, bz), cache);
+        base[std::size_t((bz * kMaxBlocks + by) * kMaxBlocks + bx)] =
+            index < 0 ? -1 : index * voxels_per_block_;
+      }
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        const int block = base[std::size_t(
+            (block_of[2][std::size_t(z)] * kMaxBlocks + block_of[1][std::size_t(y)]) * kMaxBlocks +
+            block_of[0][std::size_t(x)])];
+        const int local = (offset[2][std::size_t(z)] * side_ + offset[1][std::size_t(y)]) * side_ +
+                          offset[0][std::size_t(x)];
+        voxels[(z * n + y) * n + x] = block < 0 ? -1 : block + local;
       }
 }
 

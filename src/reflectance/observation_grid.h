@@ -146,12 +146,13 @@ class ObservationGrid {
   // Look-ups of many nearby voxels (a rendering's pixels, a mesh's vertices) may keep the
   // blocks they found in a cache of their own (one per thread), which spares most hash look-ups.
   using BlockCache = fusion::BlockIndexCache<4>;
+  static constexpr int kMaxFindVoxelsSide = 4;
   // Pool index of the voxel containing world point p, or -1.
   int find(const Eigen::Vector3f& p, BlockCache* cache = nullptr) const;
   // Pool index of the voxel at integer grid coordinates, or -1.
   int find_voxel(const Eigen::Vector3i& voxel, BlockCache* cache = nullptr) const;
   // find_voxel() of the n^3 voxels from grid coordinates `first` on (x fastest, then y, z) into
-  // voxels[0, n^3), with one block look-up per block they touch.
+  // voxels[0, n^3), with one block look-up per block they touch; n in 1..kMaxFindVoxelsSide.
   void find_voxels(const Eigen::Vector3i& first, int n, int* voxels,
                    BlockCache* cache = nullptr) const;
   // Integer grid coordinates of pool index v.

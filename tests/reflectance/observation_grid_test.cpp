@@ -95,6 +95,9 @@ TEST(ObservationGrid, FindVoxelsLooksUpACubeOfVoxelsAsFindVoxelDoes) {
           }
     }
   EXPECT_GT(found, 40);
+  std::array<int, 125> too_many;
+  EXPECT_THROW(grid.find_voxels({0, 0, 49}, 5, too_many.data()), Error);
+  EXPECT_THROW(grid.find_voxels({0, 0, 49}, 0, too_many.data()), Error);
 }
 
 TEST(ObservationGrid, OccludedAndFarVoxelsAreNotObserved) {
