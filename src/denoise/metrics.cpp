@@ -25,6 +25,9 @@ void check_finite(const ImageF& image, const char* name) {
   }
 }
 
+// A mask value above one half selects its pixel.
+bool selects(float mask_value) { return mask_value > 0.5f; }
+
 void check_pair(const ImageF& reference, const ImageF& test, const ImageF* mask) {
   if (reference.empty()) throw Error("reference image", "", "has no pixels");
   if (!reference.same_size(test) || reference.channels() != test.channels()) {
@@ -40,13 +43,13 @@ void check_pair(const ImageF& reference, const ImageF& test, const ImageF* mask)
                     std::to_string(reference.width()) + "x" + std::to_string(reference.height()));
   }
   const auto& values = mask->values();
-  if (std::none_of(values.begin(), values.end(), [](float m) { return m > 0.5f; })) {
+  if (std::none_of(values.begin(), values.end(), selects)) {
     throw Error("mask", "", "selects no pixel (none is > 0.5)");
   }
 }
 
 bool selected(const ImageF* mask, std::size_t i) {
-  return mask == nullptr || mask->values()[i] > 0.5f;
+  return mask == nullptr || selects(mask->values()[i]);
 }
 
 // Wang et al.'s window: 11×11 Gaussian, σ = 1.5, separable.
@@ -226,7 +229,7 @@ ssim_sum(const float* x, const float* y, const float* mask, SsimRows& rows) {
         for (std::size_t c = 0; c < n; ++c) column_sum[c] += map[c];
       } else {
         const float* mask_row = mask + std::size_t(row) * std::size_t(rows.width) + begin;
-        for (std::size_t c = 0; c < n; ++c) column_sum[c] += mask_row[c] > 0.5f ? map[c] : 0.0;
+        for (std::size_t c = 0; c < n; ++c) column_sum[c] += selects(mask_row[c]) ? map[c] : 0.0;
       }
     }
     sum += std::accumulate(column_sum, column_sum + n, 0.0);
