@@ -243,6 +243,25 @@ void run_reconstruct(ReconstructOptions options) {
       timings.median_ms("observations"), timings.median_ms("segmentation"),
       timings.median_ms("specular"), timings.median_ms("albedo"), timings.median_ms("total"),
       options.output);
+  const reflectance::SpecularParams& specular = options.params.specular;
+  const MaterialCoverage coverage = material_coverage(pipeline, specular.min_distinct_voxels);
+  if (coverage.without_material > 0) {
+    const reflectance::ObservationGridParams& grid = options.params.observations;
+    log().warn(
+        "{} of {} segments got no material: no frame found {} of their voxels with {} "
+        "observations each (seen in too few frames){}",
+        coverage.without_material, coverage.segments, specular.min_distinct_voxels,
+        specular.min_observations,
+        grid.min_observation_spacing_deg > 0
+            ? fmt::format("; a voxel stores a new observation only {:g} degrees from its newest{}, "
+                          "so a short sequence or a slow camera stores few: --obs-spacing 0 "
+                          "stores one every frame",
+                          grid.min_observation_spacing_deg,
+                          grid.spacing_max_frames > 0
+                              ? fmt::format(" or {} frames after it", grid.spacing_max_frames)
+                              : std::string())
+            : std::string());
+  }
   if (options.report.empty()) return;
   nlohmann::json command = command_timings.to_json();
   io::write_json(
@@ -277,6 +296,8 @@ void run_reconstruct(ReconstructOptions options) {
        {"command_timings_ms", command},
        {"render_timings_ms", render_timings.to_json()},
        {"materials", materials_json(pipeline)},
+       {"material_coverage",
+        {{"segments", coverage.segments}, {"without_material", coverage.without_material}}},
        {"evaluation", has_truth ? evaluation.to_json() : nlohmann::json(nullptr)},
        {"total_s", total.elapsed_s()}});
 }

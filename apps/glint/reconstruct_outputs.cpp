@@ -80,6 +80,18 @@ void write_material_mesh(const std::string& path,
   fusion::write_mesh_ply(path, mesh);
 }
 
+MaterialCoverage material_coverage(const reflectance::ReflectancePipeline& pipeline,
+                                   int min_voxels) {
+  const reflectance::SegmentMap& segments = pipeline.segments();
+  MaterialCoverage coverage;
+  for (int id = 1; id <= segments.max_segment_id(); ++id) {
+    if (segments.resolve(id) != id || segments.reservoir_size(id) < min_voxels) continue;
+    ++coverage.segments;
+    if (!pipeline.materials().material(id)) ++coverage.without_material;
+  }
+  return coverage;
+}
+
 nlohmann::json materials_json(const reflectance::ReflectancePipeline& pipeline) {
   const reflectance::ObservationGrid& grid = pipeline.observations();
   // Per segment, the sum of the refined kd over all its voxels with one and over the reliable

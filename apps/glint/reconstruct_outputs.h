@@ -21,6 +21,15 @@ nlohmann::json materials_json(const reflectance::ReflectancePipeline& pipeline);
 void write_materials_json(const std::string& path,
                           const reflectance::ReflectancePipeline& pipeline);
 
+// Segments that could carry a material (not merged away, with at least `min_voxels` voxel
+// references: SpecularParams::min_distinct_voxels) and how many of them have none, because no
+// frame found that many of their voxels with SpecularParams::min_observations observations.
+struct MaterialCoverage {
+  int segments = 0, without_material = 0;
+};
+MaterialCoverage material_coverage(const reflectance::ReflectancePipeline& pipeline,
+                                   int min_voxels);
+
 // OUT/frames/NNNNNN-{input,render,render-hemicnn,albedo,segments}.png (8-bit sRGB) and
 // NNNNNN-overview.png (input, re-rendering, refined albedo and segments side by side).
 void write_frame_pictures(const std::string& output, int frame, const ImageF& input_colour,

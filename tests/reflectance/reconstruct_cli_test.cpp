@@ -47,12 +47,29 @@ TEST_F(ReconstructCli, WritesTheModelMaterialsLightsPicturesAndReport) {
   EXPECT_GE(report["evaluation"]["objects"].size(), 2u);
   EXPECT_TRUE(report["evaluation"]["average"].contains("kd_ref"));
   EXPECT_GE(report["materials"]["segments"].size(), 2u);
+  EXPECT_LT(report["material_coverage"]["without_material"].get<int>(),
+            report["material_coverage"]["segments"].get<int>());
   // --device auto: the GPU where this build has CUDA and there is one.
   EXPECT_FLOAT_EQ(report["parameters"]["albedo_smoothing"].get<float>(), 0.2f);
   EXPECT_EQ(report["parameters"]["integration_device"],
             fusion::CudaIntegrator::available() ? "cuda" : "cpu");
   // The table is printed.
   EXPECT_NE(result.output.find("kd_ref"), std::string::npos);
+}
+
+// Four frames give no voxel the 5 observations an estimate needs: the run still succeeds, and
+// says which segments went without a material and why.
+TEST_F(ReconstructCli, SaysWhichSegmentsGotNoMaterial) {
+  const CommandResult result =
+      glint("reconstruct " + path("seq") + " --gt-lights --gt-poses --gt-segmentation --model " +
+            path("model.json") + " --eval-every 0 --frames 4 -o " + path("short") + " --report " +
+            path("short.json"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const nlohmann::json coverage = io::read_json(path("short.json"))["material_coverage"];
+  EXPECT_GE(coverage["segments"].get<int>(), 1);
+  EXPECT_EQ(coverage["without_material"], coverage["segments"]);
+  EXPECT_NE(result.output.find("got no material"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("--obs-spacing 0"), std::string::npos) << result.output;
 }
 
 TEST_F(ReconstructCli, OwnSegmentationRuns) {
