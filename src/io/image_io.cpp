@@ -11,7 +11,7 @@
 #include "core/error.h"
 #include "io/atomic_file.h"
 #include "io/codec.h"
-#include "io/file_bytes.h"
+#include "io/image_decode.h"
 #include "io/npy.h"
 
 namespace glint::io {
@@ -128,19 +128,7 @@ ImageF read_image(const std::string& path) {
   if (lowercase(std::filesystem::path(path).extension().string()) == ".npy")
     return read_npy_image(path);
   enable_openexr();
-  const std::string bytes = read_file_bytes(path);
-  if (bytes.empty()) throw Error(path, "", "the file is empty");
-  cv::Mat decoded;
-  try {
-    const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8U,
-                         const_cast<char*>(bytes.data()));  // imdecode only reads it
-    decoded = cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    throw Error(path, "", "cannot decode the image: " + e.err);
-  }
-  if (decoded.empty()) {
-    throw Error(path, "", "not a readable image (unknown format, corrupt or truncated)");
-  }
+  const cv::Mat decoded = decode_image_file(path, cv::IMREAD_UNCHANGED);
   return to_image(path, decoded);
 }
 

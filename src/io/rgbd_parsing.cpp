@@ -5,11 +5,11 @@
 #include <Eigen/SVD>
 #include <cmath>
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "core/error.h"
 #include "io/file_bytes.h"
+#include "io/image_decode.h"
 
 namespace glint::io::rgbd {
 
@@ -77,14 +77,7 @@ Pose pose_from_matrix(const std::string& path, const std::string& element,
 
 cv::Mat decode_image(const std::string& path, int flags) {
   require_file(path, "the image");
-  cv::Mat image;
-  try {
-    image = cv::imread(path, flags);
-  } catch (const cv::Exception& e) {
-    throw Error(path, "", "cannot decode the image: " + e.err);
-  }
-  if (image.empty()) throw Error(path, "", "not a readable image (corrupt or truncated)");
-  return image;
+  return decode_image_file(path, flags);
 }
 
 std::string join(const std::string& folder, const std::string& relative) {

@@ -46,8 +46,8 @@ const Stamped* nearest_in_time(const std::vector<Stamped>& sorted, double Stampe
   return best;
 }
 
-// Decodes an image file with cv::imread `flags`; throws glint::Error naming it when it is
-// missing or unreadable.
+// Decodes an image file with cv::imread `flags` (io/image_decode.h); throws glint::Error naming
+// it when it is missing, truncated or unreadable.
 cv::Mat decode_image(const std::string& path, int flags);
 
 // folder / relative, as a string.

@@ -114,7 +114,9 @@ TEST(ImageIo, UnreadableFilesAreErrorsNamingTheFile) {
   write_image(truncated, random_image(64, 64, 3));
   const std::string bytes = read_text(truncated);
   write_text(truncated, bytes.substr(0, bytes.size() / 2));
-  EXPECT_EQ(error_of([&] { read_image(truncated); }).file(), truncated);
+  e = error_of([&] { read_image(truncated); });
+  EXPECT_EQ(e.file(), truncated);
+  EXPECT_THAT(e.reason(), HasSubstr("truncated PNG"));
 
   // A PNG whose header says 0 pixels wide (crafted: no encoder writes one).
   const std::string zero_width = test::fixture("zero_width.png");
@@ -125,6 +127,28 @@ TEST(ImageIo, UnreadableFilesAreErrorsNamingTheFile) {
   const std::string empty = scratch("empty.exr");
   write_text(empty, "");
   EXPECT_THAT(error_of([&] { read_image(empty); }).reason(), HasSubstr("empty"));
+}
+
+// libjpeg decodes a JPEG cut short without an error (grey where the data ends), so a truncated
+// one is caught before decoding; bytes appended after a complete one are no reason to refuse it.
+TEST(ImageIo, TruncatedJpegIsAnErrorButTrailingBytesAreNot) {
+  cv::Mat colour(48, 64, CV_8UC3);
+  cv::randu(colour, 0, 255);
+  std::vector<unsigned char> encoded;
+  ASSERT_TRUE(cv::imencode(".jpg", colour, encoded));
+  const std::string jpeg(encoded.begin(), encoded.end());
+
+  const std::string whole = scratch("whole.jpg");
+  write_text(whole, jpeg + std::string(16, '\0') + "appended");
+  const ImageF image = read_image(whole);
+  EXPECT_EQ(image.width(), 64);
+  EXPECT_EQ(image.height(), 48);
+
+  const std::string truncated = scratch("truncated.jpg");
+  write_text(truncated, jpeg.substr(0, jpeg.size() * 3 / 4));
+  const Error e = error_of([&] { read_image(truncated); });
+  EXPECT_EQ(e.file(), truncated);
+  EXPECT_THAT(e.reason(), HasSubstr("truncated JPEG"));
 }
 
 TEST(ImageIo, UnwritableImagesAreErrorsNamingTheFile) {

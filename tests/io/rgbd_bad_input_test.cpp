@@ -67,6 +67,17 @@ TEST(RgbdBadInput, EightBitOrCorruptDepthIsRejected) {
   EXPECT_EQ(error_of([&] { read_rgbd_frame(sequence, 1); }).file(), sequence.frames[1].depth_path);
 }
 
+TEST(RgbdBadInput, TruncatedColourIsRejected) {
+  const std::string folder = copy_of("redwood");
+  const RgbdSequence sequence = open_rgbd_sequence(folder);
+  const std::string& colour = sequence.frames[1].colour_path;
+  const std::string bytes = test::read_text(colour);
+  test::write_text(colour, bytes.substr(0, bytes.size() - 20));
+  const Error error = error_of([&] { read_rgbd_frame(sequence, 1); });
+  EXPECT_EQ(error.file(), colour);
+  EXPECT_NE(error.reason().find("truncated PNG"), std::string::npos) << error.reason();
+}
+
 TEST(RgbdBadInput, MalformedPoseFilesNameFileAndLine) {
   const std::string scenes = copy_of("7scenes");
   const std::string pose = scenes + "/rgbd-frames/frame-000150.pose.txt";
