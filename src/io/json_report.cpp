@@ -24,6 +24,8 @@ nlohmann::json read_json(const std::string& path) {
     return nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     throw Error(path, "byte " + std::to_string(e.byte), std::string("not valid JSON: ") + e.what());
+  } catch (const nlohmann::json::exception& e) {  // e.g. a number beyond double's range
+    throw Error(path, "", std::string("not valid JSON: ") + e.what());
   }
 }
 

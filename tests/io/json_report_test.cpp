@@ -30,6 +30,14 @@ TEST(Json, ParseErrorsNameTheFileAndTheByte) {
   EXPECT_THAT(e.reason(), HasSubstr("not valid JSON"));
 }
 
+TEST(Json, ANumberBeyondDoubleNamesTheFile) {
+  const std::string path = scratch("overflow.json");
+  write_text(path, "{\"position\": [0, 1e999, 0]}");
+  const Error e = error_of([&] { read_json(path); });
+  EXPECT_EQ(e.file(), path);
+  EXPECT_THAT(e.reason(), HasSubstr("not valid JSON"));
+}
+
 TEST(Json, MissingFileAndUnwritableValues) {
   EXPECT_THAT(error_of([] { read_json(scratch("missing.json")); }).reason(),
               HasSubstr("cannot open the file"));
