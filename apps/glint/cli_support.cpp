@@ -9,6 +9,25 @@
 namespace glint::app {
 namespace {
 
+CLI::Validator sign_check(bool zero_allowed) {
+  return CLI::Validator(
+      [zero_allowed](std::string& input) -> std::string {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(input, value)) return "'" + input + "' is not a number";
+        if (zero_allowed ? value >= 0 : value > 0) return {};
+        return std::string(zero_allowed ? "must be 0 or more" : "must be more than 0") + ", got " +
+               input;
+      },
+      zero_allowed ? "NONNEGATIVE" : "POSITIVE");
+}
+
+}  // namespace
+
+const CLI::Validator kPositive = sign_check(false);
+const CLI::Validator kNonNegative = sign_check(true);
+
+namespace {
+
 bool is_point_cloud_file(const std::filesystem::path& path) {
   std::string extension = path.extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),

@@ -1,5 +1,6 @@
 #pragma once
 // Small helpers shared by the subcommands.
+#include <CLI/CLI.hpp>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,12 @@ std::vector<std::string> expand_point_cloud_inputs(const std::vector<std::string
 std::string models_directory();
 // The shipped 3-class BoundED model, the default of classify and eval.
 std::string default_edges_model();
+
+// Option checks for numbers > 0 and >= 0, shown as POSITIVE and NONNEGATIVE in --help like
+// CLI11's PositiveNumber and NonNegativeNumber, whose errors read "Value -1 not in range
+// 0.000000 to 1797693...(a 309-digit bound)"; these say "must be more than 0, got -1".
+extern const CLI::Validator kPositive;
+extern const CLI::Validator kNonNegative;
 
 // The command line as one string, for reports and model provenance (main() records it).
 void remember_command_line(int argc, char** argv);

@@ -262,16 +262,16 @@ void register_denoise_eval(CLI::App& denoise) {
                    "steps and gradients)")
       ->capture_default_str();
   command->add_option("--count", options->count, "Images: the first N of the set")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command->add_option("--crop", options->crop, "Centre crop side (0 = whole image)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   command->add_option("--methods", options->methods, "Methods to run (none: noise maps only)")
       ->delimiter(',')
       ->capture_default_str();
   command->add_option("--sigma", options->sigma, "Noise sigma on the 0-255 scale")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command->add_option("--coverage", options->coverage, "Fraction of pixels made noisy")
       ->check(CLI::Range(0.01, 0.95))
@@ -285,7 +285,7 @@ void register_denoise_eval(CLI::App& denoise) {
       ->add_option("--trace-every", options->trace_every,
                    "Neural methods: score the running estimate every N iterations into the "
                    "report (PSNR whole/clean/noisy over the iterations; 0 = off)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   command->add_option("--save", options->save, "Folder for clean/noisy/mask/guidance/results");
   command->add_option("--report", options->report, "JSON report (per image and summary)");

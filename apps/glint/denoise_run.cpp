@@ -101,7 +101,7 @@ void register_denoise_run(CLI::App& denoise) {
   command
       ->add_option("--snapshot-every", options->snapshot_every,
                    "Write the current estimate every N iterations")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   command->add_option("--snapshot-dir", options->snapshot_dir, "Folder for the snapshots")
       ->capture_default_str();
   command->add_option("--depth", options->depth, "PNG output bit depth (8 or 16)")

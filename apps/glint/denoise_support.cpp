@@ -4,6 +4,7 @@
 
 #include <chrono>
 
+#include "cli_support.h"
 #include "core/error.h"
 #include "core/progress.h"
 #include "denoise/denoise_plugin.h"
@@ -32,19 +33,19 @@ void DenoiserOptions::add_options(CLI::App& command) {
       ->capture_default_str();
   command.add_option("--seed", seed, "Seed of every random choice")->capture_default_str();
   command.add_option("--iterations", iterations, "Optimisation steps (overrides --config)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   command.add_option("--predictions", predictions, "S2S: dropout samples averaged at the end")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   command.add_option("--levels", levels, "U-Net depth (overrides --config)")
       ->check(CLI::Range(1, 8));
   command.add_option("--channels", channels, "U-Net filters per level (overrides --config)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   command.add_option("--lr", learning_rate, "Adam learning rate (overrides --config)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   command
       .add_option("--input-noise", input_noise,
                   "DIP: sigma of the per-iteration input perturbation (full 1/30, fast 0)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   command
       .add_option("--average", average,
                   "Guided DIP: eq. (14)'s output average, 'uniform' (the paper's) or 'weighted' "
@@ -56,15 +57,15 @@ void DenoiserOptions::add_options(CLI::App& command) {
   command.add_option("--dropout", dropout, "S2S: decoder dropout rate (default 0.3)")
       ->check(CLI::Range(0.0, 0.95));
   command.add_option("--kappa-w", kappa_w, "Guided DIP: warm-up iterations of eq. (16) (225)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   command.add_option("--kappa-r", kappa_r, "Guided DIP: decay rate of eq. (16) (0.15)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   command.add_option("--kappa-c", kappa_c, "Guided DIP: weight floor of eq. (16) (0.02)")
       ->check(CLI::Range(0.0, 1.0));
   command.add_option("--kappa-m", kappa_m, "Guided S2S: importance exponent of eq. (19) (2)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   command.add_option("--nlm-h", nlm.h, "NLM: filter strength on the 0-255 scale (also hColor)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command
       .add_option("--noise-method", noise_method,

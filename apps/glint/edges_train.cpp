@@ -180,17 +180,17 @@ void register_edges_train(CLI::App& edges) {
                    "(--exclude a --exclude b), e.g. to keep evaluation twins out")
       ->allow_extra_args(false);
   command->add_option("--iterations", options->params.iterations, "Training iterations")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   command->add_option("--batch", options->params.batch_size, "Points per batch")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command->add_option("--lr", options->params.learning_rate, "Adam learning rate")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command
       ->add_option("--gamma", options->params.focal_gamma, "Focal-loss gamma (0 = cross-entropy)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   command
       ->add_option("--class-weights", options->params.class_weights,
@@ -205,7 +205,7 @@ void register_edges_train(CLI::App& edges) {
   command
       ->add_option("--log-every", options->params.log_every,
                    "Iterations between validation evaluations")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command
       ->add_option("--seed", options->params.seed,

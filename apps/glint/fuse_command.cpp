@@ -144,25 +144,25 @@ void run_fuse(const FuseOptions& options) {
 
 void add_volume_options(CLI::App* command, fusion::VolumeParams& volume) {
   command->add_option("--voxel", volume.voxel_size_m, "Voxel size, metres")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command
       ->add_option("--trunc", volume.truncation_m,
                    "Truncation band half-width at depth 0, metres (grows by --trunc-per-depth per "
                    "metre of depth)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command->add_option("--trunc-per-depth", volume.truncation_per_depth, "Band growth per metre")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   command->add_option("--depth-max", volume.depth_max_m, "Ignore depth beyond this, metres")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command
       ->add_option("--blocks", volume.block_capacity,
                    "Block pool capacity (4 KiB per block, 10 KiB where the volume keeps colour; "
                    "committed as used)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command
       ->add_option("--far-every", volume.far_fusion_every,
@@ -174,7 +174,7 @@ void add_volume_options(CLI::App* command, fusion::VolumeParams& volume) {
       ->add_option("--far-voxel-pixels", volume.far_voxel_pixels,
                    "Far field: where a voxel projects to fewer pixels than this (depth beyond "
                    "voxel x fx / this)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
 }
 

@@ -264,21 +264,21 @@ void register_hemicnn_train(CLI::App& hemicnn) {
   command
       ->add_option("--lambda-d", options->params.loss.lambda_d,
                    "Weight of the diffuse (Lab) term of eq. (5); Kim et al.: 1")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   command
       ->add_option("--lambda-l", options->params.loss.lambda_l,
                    "Weight of L inside the diffuse term; Kim et al.: 1")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   command->add_option("--batches", options->params.batches, "Training batches")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   command->add_option("--batch-size", options->params.batch_size, "Sets of 25 per batch")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command->add_option("--lr", options->params.learning_rate, "Adam learning rate")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command
       ->add_option("--validation", options->params.validation_fraction,
@@ -289,13 +289,13 @@ void register_hemicnn_train(CLI::App& hemicnn) {
   command
       ->add_option("--log-every", options->params.log_every,
                    "Batches between validation evaluations")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command
       ->add_option("--torch-threads", options->params.threads,
                    "libtorch threads (1: this small net's tensors are too small to split; 2 "
                    "threads trained 2-10x slower on a 2-core machine)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command->add_flag("!--no-rotate", options->params.rotate,
                     "No random quarter turns of the sets (default: each set turned by a random "
@@ -328,7 +328,7 @@ void register_hemicnn_predict(CLI::App& hemicnn) {
       ->check(CLI::Range(0.001, 1.0))
       ->capture_default_str();
   command->add_option("--sets", options->sets, "Random sets of 25 per sequence")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command->add_option("--seed", options->seed, "Seed of the sets")->capture_default_str();
   command->add_option("--report", options->report, "Write the errors (also per sequence) as JSON");

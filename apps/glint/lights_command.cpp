@@ -153,25 +153,25 @@ void register_lights_command(CLI::App& app) {
       ->add_option("--exposure", options->exposure,
                    "Capture exposure (pixel = exposure * radiance); default: scene.json's "
                    "camera.exposure in the folder, else 1")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   command
       ->add_option("--min-luminance", params.min_luminance,
                    "Linear luminance a light pixel reaches, in [0, 1] before the exposure")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command->add_option("--bandwidth", params.clustering.bandwidth_m, "Mean-shift radius, metres")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command
       ->add_option("--merge-radius", params.fusion.merge_radius_m,
                    "Per-frame candidates this close (metres) fuse into one light")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command->add_option("--min-frames", params.fusion.min_frames, "Frames a light must be seen in")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command->add_option("--min-pixels", params.min_cluster_px, "Pixels a per-frame light needs")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command->add_flag(
       "--flat-emitters", options->flat_emitters,

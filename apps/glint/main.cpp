@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
   glint::app::CommonOptions common;
   app.add_flag("-q,--quiet", common.quiet, "No progress bars")->configurable();
   app.add_option("--threads", common.threads, "Worker threads (0 = all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(glint::app::kNonNegative);
   app.add_option("--log-level", common.log_level, "trace, debug, info, warn, error, off");
 
   glint::app::register_edges_commands(app);

@@ -334,7 +334,7 @@ void register_reconstruct_command(CLI::App& app) {
       ->add_option("--obs-voxels", params.observations.voxel_capacity,
                    "Observation voxel pool (about 0.8 KB each, committed as used); default 2^20 "
                    "at 2 cm, 2 x (0.02 / obs-voxel)^2 times that below")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   command
       ->add_option("--obs-spacing", params.observations.min_observation_spacing_deg,
                    "Degrees: an observation this close in direction to its voxel's newest stored "
@@ -347,7 +347,7 @@ void register_reconstruct_command(CLI::App& app) {
                    "Frames: an observation is stored however close to its voxel's newest one "
                    "once that is this old, so a slowly moving camera still collects enough for "
                    "the specular stage (0: never)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   add_volume_options(command, params.geometry.volume);
   add_tracking_options(command, params.geometry.tracking);
@@ -371,7 +371,7 @@ void register_reconstruct_command(CLI::App& app) {
                    "Smooth the re-renderings' normals over this radius in metres, within each "
                    "face (0 = per-pixel normals of the ray cast)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   command->add_option("--views", options->views,
                       "TUM trajectory (camera-to-world) of extra poses to re-render the final "
                       "model from, into OUT/views/");
@@ -386,7 +386,7 @@ void register_reconstruct_command(CLI::App& app) {
   command
       ->add_option("--albedo-every", params.albedo_refresh_frames,
                    "Re-solve each visible voxel's albedo every N frames (staggered)")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command
       ->add_option_function<std::string>(
@@ -412,7 +412,7 @@ void register_reconstruct_command(CLI::App& app) {
                    "observation voxels whose albedos differ by about this relative contrast or "
                    "less (a Gaussian range weight of this standard deviation; texture edges of "
                    "more contrast stay sharp); 0 = trilinear interpolation only, as the paper")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   command
       ->add_option_function<std::string>(

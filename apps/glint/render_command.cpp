@@ -78,14 +78,14 @@ void register_render_command(CLI::App& app) {
                    "Frames to render (-1 = to the end of the trajectory)")
       ->capture_default_str();
   command->add_option("--first", options->sequence.first_frame, "First trajectory index")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   command->add_option("--width", options->width, "Image width (scales the intrinsics)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   command->add_option("--height", options->height, "Image height (scales the intrinsics)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   command->add_option("--exposure", options->exposure, "Override the camera exposure")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   command->add_flag("--no-shadows", options->no_shadows, "Skip shadow rays");
   command->add_flag(
       "--no-gt", [options](std::int64_t) { options->sequence.ground_truth = false; },

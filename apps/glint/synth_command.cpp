@@ -147,11 +147,11 @@ void register_synth_command(CLI::App& app) {
   command
       ->add_option("--frames", options->frames,
                    "Frames per sequence (default: scenes 300, lights 60, training 30)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   command->add_option("--width", options->width, "Image width (default 512; training 160)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   command->add_option("--height", options->height, "Image height (default: width * 424 / 512)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   command->add_option("--seed", options->seed, "Seed of noise and of the training set")
       ->capture_default_str();
   command->add_option("--data", options->data_dir, "Data folder with meshes/, textures/, envmaps/")
@@ -161,7 +161,7 @@ void register_synth_command(CLI::App& app) {
       ->check(CLI::IsMember(render::builtin_scene_names()))
       ->capture_default_str();
   command->add_option("--sequences", options->sequences, "training: number of sequences")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   command
       ->add_option("--shapes", options->shapes,

@@ -129,7 +129,13 @@ TEST_F(ReconstructCli, BadInputsFailClearly) {
   result =
       glint("reconstruct " + path("seq") + " --gt-lights --albedo-smoothing -0.1 -o " + path("x"));
   EXPECT_NE(result.exit_code, 0);
-  EXPECT_NE(result.output.find("--albedo-smoothing"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("--albedo-smoothing: must be 0 or more, got -0.1"),
+            std::string::npos)
+      << result.output;
+  result = glint("reconstruct " + path("seq") + " --gt-lights --albedo-every 0 -o " + path("x"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("--albedo-every: must be more than 0, got 0"), std::string::npos)
+      << result.output;
   result = glint("reconstruct " + path("seq") + " --gt-lights --segment-noise 11 -o " + path("x"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("--segment-noise"), std::string::npos) << result.output;
