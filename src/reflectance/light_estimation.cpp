@@ -47,13 +47,16 @@ void validate(const LightEstimationParams& params) {
   require(!params.exposure || (*params.exposure > 0 && std::isfinite(*params.exposure)), "exposure",
           "must be > 0");
   require(params.min_cluster_px >= 1, "min_cluster_px", "must be >= 1");
+  require(params.max_bright_fraction > 0 && params.max_bright_fraction <= 1, "max_bright_fraction",
+          "must be in (0, 1]");
   require(params.clustering.bandwidth_m > 0, "bandwidth_m", "must be > 0");
   require(params.fusion.merge_radius_m > 0, "merge_radius_m", "must be > 0");
   require(params.fusion.min_frames >= 1, "min_frames", "must be >= 1");
 }
 
 // The lights one frame sees whole (clusters touching the image border are partial views).
-std::vector<LightView> frame_views(const io::RgbdFrame& frame, const Intrinsics& intrinsics,
+std::vector<LightView> frame_views(const io::RgbdFrame& frame, const std::string& colour_path,
+                                   const Intrinsics& intrinsics,
                                    const LightEstimationParams& params, float exposure) {
   LightCaptureParams capture;
   capture.min_luminance = params.min_luminance;
@@ -61,6 +64,13 @@ std::vector<LightView> frame_views(const io::RgbdFrame& frame, const Intrinsics&
   const Pose& camera_to_world = *frame.ground_truth;
   const std::vector<LightSample> samples =
       bright_samples(frame.colour, frame.depth_m, intrinsics, camera_to_world, capture);
+  const double bright_fraction = double(samples.size()) / double(frame.colour.pixel_count());
+  if (bright_fraction > params.max_bright_fraction)
+    throw Error(colour_path, "",
+                fmt::format("{:.0f} % of the pixels reach luminance {}: not a low-exposure light "
+                            "capture, where lamps are a few bright spots (capture with a lower "
+                            "exposure, or raise --min-luminance)",
+                            100 * bright_fraction, params.min_luminance));
   const std::vector<LightSample> clusters = mean_shift(samples, params.clustering);
 
   // A channel at sRGB code 254 or above has (probably) clipped.
@@ -213,8 +223,8 @@ LightEstimate estimate_lights(const io::RgbdSequence& capture, const LightEstima
 
   std::vector<std::vector<LightView>> views(capture.frames.size());
   parallel_for(capture.frames.size(), [&](std::size_t i) {
-    views[i] =
-        frame_views(io::read_rgbd_frame(capture, i), capture.intrinsics, params, estimate.exposure);
+    views[i] = frame_views(io::read_rgbd_frame(capture, i), capture.frames[i].colour_path,
+                           capture.intrinsics, params, estimate.exposure);
     if (on_frame) on_frame();
   });
 

@@ -50,6 +50,11 @@ struct LightEstimationParams {
   double min_cluster_px = 4;   // smaller per-frame clusters are noise or glints
   LightFusionParams fusion;    // merge_radius_m = 0.3, min_frames = 3
   bool spherical_emitters = true;
+  // A frame with more than this fraction of its pixels at min_luminance or above is no
+  // low-exposure capture: there the lamps are a few bright spots, while a normally exposed
+  // frame has most of its lit surfaces above the threshold, and mean shift over all of them would
+  // run for hours. Such a frame is an error naming its colour image.
+  double max_bright_fraction = 0.2;
 };
 
 // How well each estimated light is supported by the capture.

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -124,6 +125,26 @@ TEST_F(CubesCapture, ABrightThresholdAboveEveryProxyFindsNothing) {
   int frames = 0;
   EXPECT_TRUE(estimate_lights(*sequence_, params, [&] { ++frames; }).lights.empty());
   EXPECT_EQ(frames, int(sequence_->frames.size()));
+}
+
+// The main cubes sequence, normally exposed, given as a capture: most lit surfaces pass the
+// threshold, and the run is an error naming a frame's colour image instead of mean shift over
+// most of its pixels.
+TEST_F(CubesCapture, ANormallyExposedFrameIsNoCapture) {
+  render::BuiltinOptions options;
+  options.data_dir = "DATA";
+  options.frames = 2;
+  options.width = 256;
+  options.height = 212;
+  const io::RgbdSequence sequence =
+      write_capture(render::make_builtin_scene("cubes", options), "normal");
+  const Error error = test::error_of([&] { estimate_lights(sequence); });
+  EXPECT_TRUE(
+      std::any_of(sequence.frames.begin(), sequence.frames.end(),
+                  [&](const io::RgbdFrameFiles& f) { return f.colour_path == error.file(); }))
+      << error.file();
+  EXPECT_NE(error.reason().find("not a low-exposure light capture"), std::string::npos)
+      << error.reason();
 }
 
 TEST_F(CubesCapture, AFrameWithoutAPoseIsAnErrorNamingTheSequence) {
