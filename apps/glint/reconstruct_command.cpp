@@ -96,6 +96,16 @@ struct ReconstructOptions {
   reflectance::ReflectanceParams params;
 };
 
+// OUT is replaced at the end of a run: only when it is empty or a previous reconstruction (it has
+// materials.json), never a folder or file of the user's that -o happened to name.
+void require_replaceable(const std::string& output) {
+  if (!fs::exists(output)) return;
+  if (fs::is_directory(output) &&
+      (fs::is_empty(output) || fs::exists(fs::path(output) / "materials.json")))
+    return;
+  throw Error(output, "", "exists and is not a glint reconstruction; not replacing it");
+}
+
 // Removes the temporary output folder unless it was renamed into place.
 struct PartialFolder {
   std::string path;
@@ -154,6 +164,7 @@ void run_reconstruct(ReconstructOptions options) {
   // Everything goes to a temporary folder renamed onto OUT at the end: a failure leaves no
   // half-written result.
   const std::string output = options.output;
+  require_replaceable(output);
   options.output = output + ".partial-" + std::to_string(::getpid());
   fs::remove_all(options.output);
   fs::create_directories(fs::path(options.output) / "frames");
@@ -320,7 +331,11 @@ void register_reconstruct_command(CLI::App& app) {
       "re-rendering, albedo), and on synthetic sequences with gt/ the paper's Table 1 metrics\n"
       "and OUT/materials-over-time.png.");
   command->add_option("sequence", options->sequence, "RGB-D sequence folder")->required();
-  command->add_option("-o,--output", options->output, "Output folder")->required();
+  command
+      ->add_option("-o,--output", options->output,
+                   "Output folder, written whole at the end; an existing one is replaced only when "
+                   "empty or a previous reconstruction")
+      ->required();
   command->add_option("--lights", options->lights,
                       "Light-capture sequence folder (low exposure, paper §3.2) or a lights.json");
   command->add_flag("--gt-lights", options->ground_truth_lights,

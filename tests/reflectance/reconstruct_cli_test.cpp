@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "fusion/cuda_integrator.h"
@@ -153,6 +154,14 @@ TEST_F(ReconstructCli, BadInputsFailClearly) {
     EXPECT_NE(result.output.find("CUDA"), std::string::npos) << result.output;
   }
   EXPECT_FALSE(fs::exists(path("x") + "/mesh.ply"));
+  // -o naming a folder that is not a reconstruction leaves it alone.
+  fs::create_directories(path("mine"));
+  std::ofstream(path("mine") + "/notes.txt") << "keep me";
+  result = glint("reconstruct " + path("seq") + " --gt-lights --model " + path("model.json") +
+                 " --gt-poses --frames 2 -o " + path("mine"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("not a glint reconstruction"), std::string::npos) << result.output;
+  EXPECT_TRUE(fs::exists(path("mine") + "/notes.txt"));
 }
 
 }  // namespace
