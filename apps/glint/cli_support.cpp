@@ -26,6 +26,16 @@ CLI::Validator sign_check(bool zero_allowed) {
 const CLI::Validator kPositive = sign_check(false);
 const CLI::Validator kNonNegative = sign_check(true);
 
+const CLI::Validator kOutputFile(
+    [](std::string& path) -> std::string {
+      if (std::filesystem::is_directory(path)) return "'" + path + "' is a folder, not a file";
+      const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+      if (!folder.empty() && !std::filesystem::is_directory(folder))
+        return "folder '" + folder.string() + "' does not exist";
+      return {};
+    },
+    "");
+
 namespace {
 
 bool is_point_cloud_file(const std::filesystem::path& path) {

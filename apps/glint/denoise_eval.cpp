@@ -288,7 +288,8 @@ void register_denoise_eval(CLI::App& denoise) {
       ->check(kNonNegative)
       ->capture_default_str();
   command->add_option("--save", options->save, "Folder for clean/noisy/mask/guidance/results");
-  command->add_option("--report", options->report, "JSON report (per image and summary)");
+  command->add_option("--report", options->report, "JSON report (per image and summary)")
+      ->check(kOutputFile);
   options->denoiser.add_options(*command);
   command->footer(
       "Examples:\n"

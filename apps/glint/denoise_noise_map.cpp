@@ -73,7 +73,8 @@ void register_denoise_noise_map(CLI::App& denoise) {
       "or above the 95th percentile -> 0.");
   command->add_option("input", options->input, "Image (PNG 8/16-bit, EXR, ...)")->required();
   command->add_option("-o,--output", options->output, "Guidance map (16-bit PNG or EXR)")
-      ->required();
+      ->required()
+      ->check(kOutputFile);
   command->add_option("--method", options->method, "svd or var")
       ->check(CLI::IsMember({"svd", "var", "variance"}))
       ->capture_default_str();
@@ -88,7 +89,7 @@ void register_denoise_noise_map(CLI::App& denoise) {
       ->check(CLI::Range(0.5, 1.0))
       ->capture_default_str();
   command->add_option("--raw", options->raw, "Also write the raw noise level (EXR recommended)");
-  command->add_option("--report", options->report, "JSON report");
+  command->add_option("--report", options->report, "JSON report")->check(kOutputFile);
   command->footer(
       "Example:\n"
       "  glint denoise noise-map photo.png -o guidance.png --raw noise.exr\n"

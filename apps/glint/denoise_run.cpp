@@ -90,7 +90,9 @@ void register_denoise_run(CLI::App& denoise) {
       "others (eqs 17-24). Without --guidance the map is estimated from the input (SVD).\n"
       "Any channel count; values as stored in the file.");
   command->add_option("input", options->input, "Noisy image (PNG 8/16-bit, EXR, ...)")->required();
-  command->add_option("-o,--output", options->output, "Denoised image (.png or .exr)")->required();
+  command->add_option("-o,--output", options->output, "Denoised image (.png or .exr)")
+      ->required()
+      ->check(kOutputFile);
   command->add_option("--method", options->method, "guided-s2s, s2s, guided-dip, dip or nlm")
       ->check(CLI::IsMember(denoise_method_names()))
       ->capture_default_str();
@@ -107,7 +109,7 @@ void register_denoise_run(CLI::App& denoise) {
   command->add_option("--depth", options->depth, "PNG output bit depth (8 or 16)")
       ->check(CLI::IsMember({8, 16}))
       ->capture_default_str();
-  command->add_option("--report", options->report, "JSON report");
+  command->add_option("--report", options->report, "JSON report")->check(kOutputFile);
   options->denoiser.add_options(*command);
   command->footer(
       "Examples:\n"

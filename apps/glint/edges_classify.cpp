@@ -86,7 +86,7 @@ void register_edges_classify(CLI::App& edges) {
       "(red = sharp, green = boundary) besides the input's own properties.\n"
       "Example: glint edges classify scan.ply -o scan_edges.ply --png scan_edges.png");
   command->add_option("input", options->input, "Input point cloud")->required();
-  command->add_option("-o,--output", options->output, "Output PLY")->required();
+  command->add_option("-o,--output", options->output, "Output PLY")->required()->check(kOutputFile);
   command->add_option("--model", options->model,
                       "Model JSON (default: the shipped 3-class models/bounded-3c.json; "
                       "models/bounded-2c.json has no boundary class)");
@@ -96,7 +96,8 @@ void register_edges_classify(CLI::App& edges) {
                    "for a cloud much denser than the training data")
       ->delimiter(',');
   command->add_option("--png", options->png, "Also draw the labelled cloud to this PNG");
-  command->add_option("--report", options->report, "Write a JSON report (counts, timings)");
+  command->add_option("--report", options->report, "Write a JSON report (counts, timings)")
+      ->check(kOutputFile);
   command->callback([options] { run_classify(*options); });
 }
 

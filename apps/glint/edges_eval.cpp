@@ -191,7 +191,7 @@ void register_edges_eval(CLI::App& edges) {
                    "CA surface-variation threshold (0.025: thesis, tuned on Default)")
       ->capture_default_str();
   command->add_flag("--no-baseline", options->no_baseline, "Skip the CA baseline");
-  command->add_option("--report", options->report, "Write all scores as JSON");
+  command->add_option("--report", options->report, "Write all scores as JSON")->check(kOutputFile);
   command->callback([options] { run_eval(*options); });
 }
 

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "cli_support.h"
 #include "commands.h"
 #include "core/error.h"
 #include "edges/features.h"
@@ -77,7 +78,9 @@ void register_edges_features(CLI::App& edges) {
       "c_perp, c_parallel, in the normalised frame of eq. 5.4. Columns are scale-major.\n"
       "Example: glint edges features cloud.ply -o cloud_features.npy");
   command->add_option("input", options->input, "Input point cloud")->required();
-  command->add_option("-o,--output", options->output, "Output .npy (float32) or .csv")->required();
+  command->add_option("-o,--output", options->output, "Output .npy (float32) or .csv")
+      ->required()
+      ->check(kOutputFile);
   command->add_option("--scales", options->scales, "Neighbourhood sizes, largest first")
       ->delimiter(',')
       ->capture_default_str();

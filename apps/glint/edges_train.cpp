@@ -163,7 +163,9 @@ void register_edges_train(CLI::App& edges) {
       defaults.focal_gamma, defaults.learning_rate, defaults.batch_size, defaults.iterations,
       100 * defaults.validation_fraction));
   command->add_option("DATA", options->inputs, "Labelled point-cloud files or folders")->required();
-  command->add_option("-o,--output", options->output, "Model file to write (.json)")->required();
+  command->add_option("-o,--output", options->output, "Model file to write (.json)")
+      ->required()
+      ->check(kOutputFile);
   command
       ->add_option("--classes", options->config.classes,
                    "3: non-edge/sharp/boundary; 2: non-edge/sharp (boundary counts as non-edge)")
@@ -218,7 +220,8 @@ void register_edges_train(CLI::App& edges) {
                     "Keep the raw argmax decision (default: after training, shift the non-edge "
                     "logit to maximise the mean edge-class F1 on the validation points)");
   command->add_option("--notes", options->notes, "Free text stored in the model's training record");
-  command->add_option("--report", options->report, "Write a JSON report (inputs, timings, losses)");
+  command->add_option("--report", options->report, "Write a JSON report (inputs, timings, losses)")
+      ->check(kOutputFile);
   command->callback([options] { run_train(*options); });
 }
 

@@ -214,7 +214,8 @@ void register_fuse_command(CLI::App& app) {
       "TUM RGB-D, 7-Scenes/tsdf-fusion (frame-*.depth.png) and Redwood/Open3D (color/, depth/).");
   command->add_option("dataset", options->dataset, "RGB-D sequence folder")->required();
   command->add_option("-o,--output", options->mesh, "Mesh (PLY, binary, sRGB vertex colours)")
-      ->required();
+      ->required()
+      ->check(kOutputFile);
   add_volume_options(command, options->params.volume);
   add_tracking_options(command, options->params.tracking);
   add_integration_device_option(command, options->params.device);
@@ -225,8 +226,10 @@ void register_fuse_command(CLI::App& app) {
   command->add_option("--trajectory", options->trajectory,
                       "Write the camera trajectory (TUM format, camera-to-world)");
   command->add_option("--points", options->points, "Also write the mesh vertices as a PLY cloud");
-  command->add_option("--report", options->report,
-                      "JSON report: parameters, per-stage timings (median/mean/p90 ms), ATE");
+  command
+      ->add_option("--report", options->report,
+                   "JSON report: parameters, per-stage timings (median/mean/p90 ms), ATE")
+      ->check(kOutputFile);
   command->footer(
       "Examples:\n"
       "  glint fuse data/rgbd/7scenes-50 -o kitchen.ply --gt-poses --report fuse.json\n"

@@ -260,7 +260,9 @@ void register_hemicnn_train(CLI::App& hemicnn) {
       defaults.learning_rate, defaults.batch_size, 100 * defaults.validation_fraction,
       defaults.batches));
   command->add_option("DATASET", options->dataset, "Hemi-image dataset folder")->required();
-  command->add_option("-o,--output", options->output, "Model file to write (.json)")->required();
+  command->add_option("-o,--output", options->output, "Model file to write (.json)")
+      ->required()
+      ->check(kOutputFile);
   command
       ->add_option("--lambda-d", options->params.loss.lambda_d,
                    "Weight of the diffuse (Lab) term of eq. (5); Kim et al.: 1")
@@ -302,7 +304,8 @@ void register_hemicnn_train(CLI::App& hemicnn) {
                     "multiple of 90 degrees)");
   command->add_option("--seed", options->params.seed, "Seed of the initialisation and the sets")
       ->capture_default_str();
-  command->add_option("--report", options->report, "Write a JSON report (timings, losses)");
+  command->add_option("--report", options->report, "Write a JSON report (timings, losses)")
+      ->check(kOutputFile);
   command->callback([options] { run_train(*options); });
 }
 
@@ -331,7 +334,8 @@ void register_hemicnn_predict(CLI::App& hemicnn) {
       ->check(kPositive)
       ->capture_default_str();
   command->add_option("--seed", options->seed, "Seed of the sets")->capture_default_str();
-  command->add_option("--report", options->report, "Write the errors (also per sequence) as JSON");
+  command->add_option("--report", options->report, "Write the errors (also per sequence) as JSON")
+      ->check(kOutputFile);
   command->callback([options] { run_predict(*options); });
 }
 

@@ -148,7 +148,9 @@ void register_lights_command(CLI::App& app) {
       "by its own exposure to compare.");
   command->add_option("capture", options->capture, "Light-capture sequence folder (with poses)")
       ->required();
-  command->add_option("-o,--output", options->output, "lights.json to write")->required();
+  command->add_option("-o,--output", options->output, "lights.json to write")
+      ->required()
+      ->check(kOutputFile);
   command
       ->add_option("--exposure", options->exposure,
                    "Capture exposure (pixel = exposure * radiance); default: scene.json's "
@@ -176,9 +178,11 @@ void register_lights_command(CLI::App& app) {
   command->add_flag(
       "--flat-emitters", options->flat_emitters,
       "Lamps are flat (panels): no correction from the seen cap to a sphere's centre");
-  command->add_option("--report", options->report,
-                      "JSON report: parameters, lights, ground-truth errors when scene.json has "
-                      "lights");
+  command
+      ->add_option("--report", options->report,
+                   "JSON report: parameters, lights, ground-truth errors when scene.json has "
+                   "lights")
+      ->check(kOutputFile);
   command->footer(
       "Prints each light and, when the capture folder's scene.json holds ground-truth lights,\n"
       "the position error and intensity ratio per light.\n"

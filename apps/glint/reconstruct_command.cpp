@@ -460,8 +460,10 @@ void register_reconstruct_command(CLI::App& app) {
           "Seed of the voxel sampling (each segment's voxel reservoir and each frame's draw "
           "from it)")
       ->default_str(std::to_string(params.specular.seed));
-  command->add_option("--report", options->report,
-                      "JSON report: parameters, per-stage timings, materials, evaluation");
+  command
+      ->add_option("--report", options->report,
+                   "JSON report: parameters, per-stage timings, materials, evaluation")
+      ->check(kOutputFile);
   command->footer(
       "Examples:\n"
       "  glint synth bunnies -o seq/bunnies && glint synth lights --scene bunnies -o seq/cap\n"

@@ -90,7 +90,7 @@ void register_render_command(CLI::App& app) {
   command->add_flag(
       "--no-gt", [options](std::int64_t) { options->sequence.ground_truth = false; },
       "Do not write gt/");
-  command->add_option("--report", options->report, "JSON report");
+  command->add_option("--report", options->report, "JSON report")->check(kOutputFile);
   command->footer(
       "Examples:\n"
       "  glint render scene.json -o seq\n"

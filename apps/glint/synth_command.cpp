@@ -173,7 +173,8 @@ void register_synth_command(CLI::App& app) {
   command->add_flag("--no-shadows", options->no_shadows, "Scenes: no shadow rays");
   command->add_flag("--preview", options->preview,
                     "Only frame 0 as PNGs for people: rgb, depth (false colour), kd, ks, alpha");
-  command->add_option("--report", options->report, "JSON report with parameters and timings");
+  command->add_option("--report", options->report, "JSON report with parameters and timings")
+      ->check(kOutputFile);
   command->footer(
       "Scenes, materials, lights and cameras are listed in src/render/builtin_scenes.h; the\n"
       "training-set ranges in src/render/training_set.h. Sequences use the format of\n"
