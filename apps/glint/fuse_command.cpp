@@ -61,6 +61,8 @@ void run_fuse(const FuseOptions& options) {
   const io::RgbdSequence sequence = io::open_rgbd_sequence(options.dataset);
   const std::size_t frames =
       options.frames ? std::min(options.frames, sequence.frames.size()) : sequence.frames.size();
+  if (options.params.use_ground_truth_poses)
+    sequence.require_ground_truth(frames, "--gt-poses needs every frame's (drop it to track)");
   fusion::FusionPipeline pipeline(sequence.intrinsics, options.params);
   StageTimings command_timings;  // "read" per frame, "mesh" once
   std::vector<io::StampedPose> trajectory;

@@ -147,6 +147,8 @@ void run_reconstruct(ReconstructOptions options) {
   const io::RgbdSequence sequence = io::open_rgbd_sequence(options.sequence);
   const std::size_t frames =
       options.frames ? std::min(options.frames, sequence.frames.size()) : sequence.frames.size();
+  if (options.params.geometry.use_ground_truth_poses)
+    sequence.require_ground_truth(frames, "--gt-poses needs every frame's (drop it to track)");
   const bool has_truth = reflectance::has_ground_truth_maps(sequence);
   if (options.ground_truth_segmentation && !has_truth)
     throw Error(options.sequence, "--gt-segmentation", "the sequence has no gt/segment maps");

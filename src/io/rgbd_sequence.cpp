@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <tbb/parallel_invoke.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -88,6 +89,13 @@ bool RgbdSequence::has_ground_truth() const {
     if (frame.ground_truth) return true;
   }
   return false;
+}
+
+void RgbdSequence::require_ground_truth(std::size_t count, const std::string& needed_for) const {
+  for (std::size_t i = 0; i < std::min(count, frames.size()); ++i)
+    if (!frames[i].ground_truth)
+      throw Error(folder, "frame " + std::to_string(i) + " (" + frames[i].colour_path + ")",
+                  "no ground-truth camera pose; " + needed_for);
 }
 
 RgbdSequence open_rgbd_sequence(const std::string& folder) {

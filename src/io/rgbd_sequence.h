@@ -46,6 +46,9 @@ struct RgbdSequence {
   std::vector<RgbdFrameFiles> frames;
 
   bool has_ground_truth() const;
+  // Throws glint::Error naming the folder and the first of frames [0, count) without a
+  // ground-truth pose (its pose file has none for it), the reason ending in `needed_for`.
+  void require_ground_truth(std::size_t count, const std::string& needed_for) const;
 };
 
 struct RgbdFrame {

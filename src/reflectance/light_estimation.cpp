@@ -212,11 +212,8 @@ float capture_exposure(const std::string& folder) {
 LightEstimate estimate_lights(const io::RgbdSequence& capture, const LightEstimationParams& params,
                               const std::function<void()>& on_frame) {
   validate(params);
-  for (std::size_t i = 0; i < capture.frames.size(); ++i)
-    if (!capture.frames[i].ground_truth)
-      throw Error(capture.folder, fmt::format("frame {} ({})", i, capture.frames[i].colour_path),
-                  "no ground-truth camera pose; lighting estimation needs the pose of every "
-                  "capture frame");
+  capture.require_ground_truth(capture.frames.size(),
+                               "lighting estimation needs the pose of every capture frame");
   LightEstimate estimate;
   estimate.capture = capture.folder;
   estimate.exposure = params.exposure ? *params.exposure : capture_exposure(capture.folder);

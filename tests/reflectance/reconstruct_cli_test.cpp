@@ -172,6 +172,20 @@ TEST_F(ReconstructCli, BadInputsFailClearly) {
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("does not exist"), std::string::npos) << result.output;
   EXPECT_FALSE(fs::exists(path("y")));
+  // --gt-poses with a frame the pose file leaves out: named before the run starts.
+  fs::copy(path("seq"), path("gaps"), fs::copy_options::recursive);
+  {
+    std::ifstream in(path("gaps") + "/groundtruth.txt");
+    std::string line, kept;
+    for (int n = 0; std::getline(in, line); ++n)
+      if (n != 3) kept += line + "\n";  // line 0 is the header: frame 2 loses its pose
+    std::ofstream(path("gaps") + "/groundtruth.txt") << kept;
+  }
+  result = glint("reconstruct " + path("gaps") + " --gt-lights --gt-poses -o " + path("y"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("frame 2"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("no ground-truth camera pose"), std::string::npos) << result.output;
+  EXPECT_FALSE(fs::exists(path("y")));
 }
 
 }  // namespace
