@@ -266,7 +266,7 @@ void run_reconstruct(ReconstructOptions options) {
         coverage.without_material, coverage.segments, specular.min_distinct_voxels,
         specular.min_observations,
         grid.min_observation_spacing_deg > 0
-            ? fmt::format("; a voxel stores a new observation only {:g} degrees from its newest{}, "
+            ? fmt::format("; a voxel stores a new observation only {:g}° from its newest{}, "
                           "so a short sequence or a slow camera stores few: --obs-spacing 0 "
                           "stores one every frame",
                           grid.min_observation_spacing_deg,
