@@ -29,9 +29,13 @@ const CLI::Validator kNonNegative = sign_check(true);
 const CLI::Validator kOutputFile(
     [](std::string& path) -> std::string {
       if (std::filesystem::is_directory(path)) return "'" + path + "' is a folder, not a file";
-      const std::filesystem::path folder = std::filesystem::path(path).parent_path();
-      if (!folder.empty() && !std::filesystem::is_directory(folder))
-        return "folder '" + folder.string() + "' does not exist";
+      // Missing folders are created when the file is written; one that is a file cannot be.
+      for (std::filesystem::path folder = std::filesystem::path(path).parent_path();
+           !folder.empty(); folder = folder.parent_path()) {
+        if (std::filesystem::is_directory(folder)) break;
+        if (std::filesystem::exists(folder))
+          return "'" + folder.string() + "' is a file, not a folder";
+      }
       return {};
     },
     "");

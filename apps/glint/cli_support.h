@@ -20,8 +20,9 @@ std::string default_edges_model();
 // 0.000000 to 1797693...(a 309-digit bound)"; these say "must be more than 0, got -1".
 extern const CLI::Validator kPositive;
 extern const CLI::Validator kNonNegative;
-// A file to write: not an existing folder, in a folder that exists. Checked when the command
-// line is read, so that a long run does not end in "cannot move the finished file into place".
+// A file to write: not an existing folder, and no file where one of its folders should be
+// (missing folders are created when it is written). Checked when the command line is read, so
+// that a long run does not end in "cannot move the finished file into place".
 extern const CLI::Validator kOutputFile;
 
 // The command line as one string, for reports and model provenance (main() records it).

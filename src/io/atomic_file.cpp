@@ -22,6 +22,10 @@ void remove_quietly(const std::string& path) {
 
 AtomicFile::AtomicFile(std::string path, bool binary)
     : path_(std::move(path)), temporary_(path_ + ".tmp-" + std::to_string(::getpid())) {
+  const std::filesystem::path folder = std::filesystem::path(path_).parent_path();
+  std::error_code error;
+  if (!folder.empty()) std::filesystem::create_directories(folder, error);
+  if (error) throw Error(path_, "", "cannot create its folder: " + error.message());
   stream_.open(temporary_, binary ? std::ios::out | std::ios::binary : std::ios::out);
   if (!stream_) {
     throw Error(path_, "", std::string("cannot create the file: ") + std::strerror(errno));

@@ -8,7 +8,8 @@ namespace glint::io {
 
 class AtomicFile {
  public:
-  // Opens "<path>.tmp-<pid>" for writing; throws glint::Error naming `path` when it cannot.
+  // Creates the folders `path` lies in when missing and opens "<path>.tmp-<pid>" for writing;
+  // throws glint::Error naming `path` when it cannot.
   explicit AtomicFile(std::string path, bool binary = true);
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;

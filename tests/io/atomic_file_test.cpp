@@ -58,12 +58,23 @@ TEST(AtomicFile, CommitReplacesTheTargetAndLeavesNoTemporary) {
   EXPECT_EQ(files_in(test::scratch_folder()), std::vector<std::string>{"atomic.bin"});
 }
 
-TEST(AtomicFile, MissingFolderIsAnError) {
-  const std::string path = scratch("missing/out.ply");
+TEST(AtomicFile, CreatesMissingFolders) {
+  const std::string path = scratch("missing/deeper/out.txt");
+  {
+    AtomicFile file(path, false);
+    file.stream() << "data";
+    file.commit();
+  }
+  EXPECT_EQ(read_text(path), "data");
+}
+
+TEST(AtomicFile, AFileWhereAFolderShouldBeIsAnError) {
+  write_text(scratch("plain"), "a file");
+  const std::string path = scratch("plain/out.ply");
   const Error e = error_of([&] { AtomicFile file(path); });
   EXPECT_EQ(e.file(), path);
   EXPECT_EQ(e.element(), "");
-  EXPECT_EQ(e.reason(), "cannot create the file: No such file or directory");
+  EXPECT_THAT(e.reason(), ::testing::HasSubstr("cannot create its folder"));
 }
 
 TEST(AtomicFile, FailedRenameIsAnErrorAndRemovesTheTemporary) {

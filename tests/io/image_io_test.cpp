@@ -169,8 +169,9 @@ TEST(ImageIo, UnwritableImagesAreErrorsNamingTheFile) {
   EXPECT_EQ(e.file(), path);
   EXPECT_EQ(e.element(), "pixel (1, 2), channel 1");
   EXPECT_FALSE(std::filesystem::exists(path));
-  EXPECT_EQ(error_of([&] { write_image(scratch("missing/image.exr"), image); }).file(),
-            scratch("missing/image.exr"));
+  test::write_text(scratch("plain"), "a file, not a folder");
+  EXPECT_EQ(error_of([&] { write_image(scratch("plain/image.exr"), image); }).file(),
+            scratch("plain/image.exr"));
 }
 
 }  // namespace

@@ -37,7 +37,8 @@ inline std::filesystem::path scratch_folder() {
 // A path in the test's folder, with no file there yet.
 inline std::string scratch(const std::string& name) {
   const auto path = scratch_folder() / name;
-  std::filesystem::remove(path);
+  std::error_code below_a_file;  // a path below a file cannot hold one either
+  std::filesystem::remove(path, below_a_file);
   return path.string();
 }
 

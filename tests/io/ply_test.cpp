@@ -286,13 +286,14 @@ TEST(Ply, MissingFileAndFolder) {
               HasSubstr("is a folder"));
 }
 
-TEST(Ply, WriteIntoMissingFolderFailsCleanly) {
-  const std::string path = scratch("no_such_folder/out.ply");
+TEST(Ply, WriteBelowAFileFailsCleanly) {
+  test::write_text(scratch("plain"), "a file, not a folder");
+  const std::string path = scratch("plain/out.ply");
   const Error e = error_of([&] { write_ply(path, every_type_cloud()); });
   EXPECT_EQ(e.file(), path);
   EXPECT_EQ(e.element(), "");
-  EXPECT_THAT(e.reason(), HasSubstr("cannot create the file: "));
-  EXPECT_FALSE(std::filesystem::exists(std::filesystem::path(path).parent_path()));
+  EXPECT_THAT(e.reason(), HasSubstr("cannot create its folder: "));
+  EXPECT_EQ(test::read_text((test::scratch_folder() / "plain").string()), "a file, not a folder");
 }
 
 TEST(Ply, WriteRejectsNamesThatCannotBeProperties) {

@@ -162,15 +162,15 @@ TEST_F(ReconstructCli, BadInputsFailClearly) {
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("not a glint reconstruction"), std::string::npos) << result.output;
   EXPECT_TRUE(fs::exists(path("mine") + "/notes.txt"));
-  // A report path that is a folder, or in a folder that does not exist, fails before the run.
+  // A report path that is a folder, or below a file, fails before the run.
   result = glint("reconstruct " + path("seq") + " --gt-lights -o " + path("y") + " --report " +
                  path("mine"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("is a folder, not a file"), std::string::npos) << result.output;
   result = glint("reconstruct " + path("seq") + " --gt-lights -o " + path("y") + " --report " +
-                 path("absent") + "/report.json");
+                 path("mine") + "/notes.txt/report.json");
   EXPECT_NE(result.exit_code, 0);
-  EXPECT_NE(result.output.find("does not exist"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("is a file, not a folder"), std::string::npos) << result.output;
   EXPECT_FALSE(fs::exists(path("y")));
   // --gt-poses with a frame the pose file leaves out: named before the run starts.
   fs::copy(path("seq"), path("gaps"), fs::copy_options::recursive);
