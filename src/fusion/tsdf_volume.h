@@ -10,6 +10,7 @@
 // red, green, blue, weighted mean linear colour (only in volumes that keep colour).
 #include <Eigen/Core>
 #include <atomic>
+#include <bit>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -68,11 +69,22 @@ class TsdfVolume {
   const float* green(int block) const { return green_.get() + voxel_offset(block); }
   const float* blue(int block) const { return blue_.get() + voxel_offset(block); }
 
-  // Asks for a block's distances (2 KB) ahead of reading them (TsdfSampler reads no weights).
-  void prefetch_block(int block) const {
+  // A block's distances (2 KB) as 32 cache lines: line k holds the rows (z * 8 + y) = 2k and
+  // 2k + 1. The lines holding the rows y0..y1 of the slices z0..z1 (block coordinates, 0..7),
+  // as bits.
+  static std::uint32_t distance_lines(int y0, int y1, int z0, int z1) {
+    std::uint32_t lines = 0;
+    for (int z = z0; z <= z1; ++z)
+      for (int y = y0 & ~1; y <= y1; y += 2) lines |= 1u << ((z * kBlockSide + y) >> 1);
+    return lines;
+  }
+  // Asks for the lines of a block's distances named by the bits of `lines` ahead of reading them
+  // (TsdfSampler reads no weights).
+  void prefetch_distance_lines(int block, std::uint32_t lines) const {
+    static_assert(kVoxelsPerBlock * sizeof(float) == 32 * 64);
     constexpr int kFloatsPerLine = 64 / sizeof(float);
-    for (int offset = 0; offset < kVoxelsPerBlock; offset += kFloatsPerLine)
-      __builtin_prefetch(sdf_m(block) + offset);
+    for (; lines != 0; lines &= lines - 1)
+      __builtin_prefetch(sdf_m(block) + std::countr_zero(lines) * kFloatsPerLine);
   }
 
   // How many frames have been fused into a block (saturating at 255). integrate_blocks counts

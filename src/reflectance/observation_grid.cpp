@@ -100,32 +100,50 @@ void ObservationGrid::prefetch_voxel_state(int block) const {
   prefetch_lines(newest_.get() + first, voxels * sizeof(NewestObservation));
 }
 
-Eigen::Vector3i ObservationGrid::geometry_block(int block, float geometry_blocks_per_block) const {
-  const Eigen::Vector3f centre =
-      (hash_.block(block).cast<float>() + Eigen::Vector3f::Constant(0.5f)) *
-      geometry_blocks_per_block;
-  return {int(std::floor(centre.x())), int(std::floor(centre.y())), int(std::floor(centre.z()))};
+void ObservationGrid::GeometryReads::add(const Eigen::Vector3i& block, std::uint32_t block_lines) {
+  for (int i = 0; i < count; ++i)
+    if (blocks[std::size_t(i)] == block) {
+      lines[std::size_t(i)] |= block_lines;
+      return;
+    }
+  if (count == kCapacity) return;
+  blocks[std::size_t(count)] = block;
+  lines[std::size_t(count++)] = block_lines;
 }
 
-unsigned ObservationGrid::geometry_blocks_due(int block, int frame) const {
-  // A surface refresh reads a 4^3 stencil of TSDF voxels around the point (TsdfSampler::
-  // trilinear_with_gradient): from a voxel in the block's last layer along an axis it reaches
-  // into the next geometry block along that axis.
+void ObservationGrid::geometry_reads_due(int block, int frame, float inverse_geometry_voxel,
+                                         GeometryReads& reads) const {
+  // A refresh first reads the 4^3 TSDF voxels from floor(p) - 1 on around its start p, the
+  // surface point or (without one) the voxel centre (TsdfSampler::trilinear_with_gradient). Only
+  // those lines are asked for: the whole 2 KB of the block under the voxel and of the up to seven
+  // its stencils might reach was 8 x 32 lines for a few dozen read, and those prefetches stalled
+  // on the full line-fill buffers (perf, cubes at 2 cm: half of the visibility pass's samples).
+  // A second Newton step from a voxel centre reads around its landing point, when it is read.
+  reads.count = 0;
   const int first = block * voxels_per_block_;
-  unsigned reaches_next = 0;  // bit a: a due voxel's stencil reaches the next block along axis a
-  bool due = false;
+  const Eigen::Vector3i first_voxel = hash_.block(block) * side_;
+  constexpr int kShift = 3;  // TSDF voxel -> block: floor division by kBlockSide
+  static_assert(fusion::kBlockSide == 1 << kShift);
   for (int local = 0; local < voxels_per_block_; ++local) {
-    if (frame < next_refresh_frame_[first + local]) continue;
-    due = true;
-    const Eigen::Vector3i coordinates = local_coordinates(local);
-    for (int axis = 0; axis < 3; ++axis)
-      if (coordinates[axis] == side_ - 1) reaches_next |= 1u << axis;
+    const int v = first + local;
+    if (frame < next_refresh_frame_[v]) continue;
+    const Eigen::Vector3f start =
+        (has_surface_[v] ? position_[v] : voxel_centre(first_voxel + local_coordinates(local))) *
+        inverse_geometry_voxel;
+    const Eigen::Vector3i low(int(std::floor(start.x())) - 1, int(std::floor(start.y())) - 1,
+                              int(std::floor(start.z())) - 1);
+    const Eigen::Vector3i high = low + Eigen::Vector3i::Constant(3);
+    for (int bz = low.z() >> kShift; bz <= high.z() >> kShift; ++bz)
+      for (int by = low.y() >> kShift; by <= high.y() >> kShift; ++by)
+        for (int bx = low.x() >> kShift; bx <= high.x() >> kShift; ++bx) {
+          const auto in_block = [](int value, int b) {
+            return std::clamp(value - (b << kShift), 0, fusion::kBlockSide - 1);
+          };
+          reads.add({bx, by, bz}, fusion::TsdfVolume::distance_lines(
+                                      in_block(low.y(), by), in_block(high.y(), by),
+                                      in_block(low.z(), bz), in_block(high.z(), bz)));
+        }
   }
-  if (!due) return 0;
-  unsigned blocks = 0;  // bit (x | y << 1 | z << 2) for the geometry block at that offset
-  for (unsigned offset = 0; offset < 8; ++offset)
-    if ((offset & ~reaches_next) == 0) blocks |= 1u << offset;
-  return blocks;
 }
 
 ObservationGrid::ObservationGrid(const ObservationGridParams& params)
@@ -405,8 +423,7 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
   };
   constexpr int kBatch = 128, kInsertFrom = 32;  // voxels pending, and at least this many
   const std::size_t blocks = frame_blocks_.size();
-  const float geometry_blocks_per_block =
-      float(params_.block_size_m / geometry.params().block_size_m());
+  const float inverse_geometry_voxel = 1.0f / float(geometry.params().voxel_size_m);
   block_refreshed_.assign(blocks, 0);
   parallel_for_chunks(blocks, 16, [&](std::size_t begin, std::size_t end) {
     fusion::TsdfSampler sampler(geometry);  // its block cache serves each block's voxels
@@ -417,14 +434,8 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
     std::vector<Projection> projections(voxels_per_block_);
     std::array<Seen, kBatch> seen;
     int pending = 0;
-    // geometry_blocks_due() of the blocks ahead, by slot % 4.
-    std::array<unsigned, 4> due_geometry{};
-    const auto for_each_geometry_block = [&](int block, unsigned due, auto&& visit) {
-      const Eigen::Vector3i origin = geometry_block(block, geometry_blocks_per_block);
-      for (unsigned offset = 0; offset < 8; ++offset)
-        if (due >> offset & 1)
-          visit(origin + Eigen::Vector3i(offset & 1, (offset >> 1) & 1, (offset >> 2) & 1));
-    };
+    // geometry_reads_due() of the blocks ahead, by slot % 4.
+    std::array<GeometryReads, 4> due_reads;
     const auto insert_pending = [&] {
       for (int i = 0; i < pending; ++i) {
         const Seen& voxel = seen[i];
@@ -448,31 +459,35 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
     for (std::size_t slot = begin; slot < end; ++slot) {
       if (pending >= kInsertFrom || pending + voxels_per_block_ > kBatch) insert_pending();
       // A software pipeline over the blocks. Three ahead: the voxel state. Two ahead: the hash
-      // slots of the geometry blocks that the due refreshes' stencils reach, including the
-      // neighbours beyond the block under this one. One ahead: those blocks' voxels. With only the
-      // block under this one asked for, just before use, the refreshes stalled on the TSDF's
-      // reads (cubes: 1,410 TSC cycles per refresh; 760 with the pipeline).
+      // slots of the geometry blocks that the due refreshes' stencils reach, including
+      // neighbours of the block under this one. One ahead: the lines of those blocks' distances
+      // that the stencils read. With only the block under this one asked for, just before use,
+      // the refreshes stalled on the TSDF's reads (cubes: 1,410 TSC cycles per refresh; 760 with
+      // the pipeline).
       const auto ahead = [&](std::size_t n) {
         return frame_blocks_[std::min(slot + n, blocks - 1)];
       };
-      const auto prefetch_geometry = [&](std::size_t n) {
-        for_each_geometry_block(ahead(n), due_geometry[(slot + n) % 4],
-                                [&](const Eigen::Vector3i& g) {
-                                  const int index = geometry.hash().find(g);
-                                  if (index >= 0) geometry.prefetch_block(index);
-                                });
+      const auto find_reads = [&](std::size_t n) {
+        GeometryReads& reads = due_reads[(slot + n) % 4];
+        geometry_reads_due(ahead(n), frame, inverse_geometry_voxel, reads);
+        for (int i = 0; i < reads.count; ++i)
+          geometry.hash().prefetch(reads.blocks[std::size_t(i)]);
+      };
+      const auto prefetch_reads = [&](std::size_t n) {
+        const GeometryReads& reads = due_reads[(slot + n) % 4];
+        for (int i = 0; i < reads.count; ++i) {
+          const int index = geometry.hash().find(reads.blocks[std::size_t(i)]);
+          if (index >= 0) geometry.prefetch_distance_lines(index, reads.lines[std::size_t(i)]);
+        }
       };
       if (slot == begin) {
         for (std::size_t n = 0; n < 3; ++n) prefetch_voxel_state(ahead(n));
-        for (std::size_t n = 0; n < 2; ++n)
-          due_geometry[(slot + n) % 4] = geometry_blocks_due(ahead(n), frame);
-        prefetch_geometry(0);
+        for (std::size_t n = 0; n < 2; ++n) find_reads(n);
+        prefetch_reads(0);
       }
       prefetch_voxel_state(ahead(3));
-      due_geometry[(slot + 2) % 4] = geometry_blocks_due(ahead(2), frame);
-      for_each_geometry_block(ahead(2), due_geometry[(slot + 2) % 4],
-                              [&](const Eigen::Vector3i& g) { geometry.hash().prefetch(g); });
-      prefetch_geometry(1);
+      find_reads(2);
+      prefetch_reads(1);
       const int block = ahead(0);
       const Eigen::Vector3i first_voxel = hash_.block(block) * side_;
       // Two passes over the block's voxels: the first refreshes surfaces, projects them and asks

@@ -196,13 +196,19 @@ class ObservationGrid {
   void fit_normals_to_neighbours(std::size_t slot, int frame);
   // Prefetches the per-voxel state collect() reads first for the voxels of `block`.
   void prefetch_voxel_state(int block) const;
-  // The geometry (TSDF) block that holds the centre of observation block `block`, given the
-  // ratio of the two block sizes.
-  Eigen::Vector3i geometry_block(int block, float geometry_blocks_per_block) const;
-  // The geometry blocks that the surface refreshes due in `frame` for the voxels of `block` read:
-  // bit (x | y << 1 | z << 2) for the block at that offset from geometry_block(); 0 when none is
-  // due.
-  unsigned geometry_blocks_due(int block, int frame) const;
+  // The TSDF (geometry) blocks and, per block, the cache lines of its distances that the first
+  // reads of a block's due surface refreshes touch (fusion::TsdfVolume::distance_lines).
+  struct GeometryReads {
+    static constexpr int kCapacity = 16;  // more are not prefetched (read when needed)
+    int count = 0;
+    std::array<Eigen::Vector3i, kCapacity> blocks;
+    std::array<std::uint32_t, kCapacity> lines;
+    void add(const Eigen::Vector3i& block, std::uint32_t block_lines);
+  };
+  // Those of the refreshes due in `frame` for the voxels of `block`; `inverse_geometry_voxel` is
+  // 1 / the TSDF's voxel size.
+  void geometry_reads_due(int block, int frame, float inverse_geometry_voxel,
+                          GeometryReads& reads) const;
 
   ObservationGridParams params_;
   int side_ = 2;

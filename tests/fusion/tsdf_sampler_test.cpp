@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <vector>
 
 #include "fusion_test_support.h"
@@ -118,6 +119,27 @@ TEST(TsdfSampler, ABlockOfTheSameParityIsLookedUpAfresh) {
   EXPECT_EQ(sampler.voxel(3, 3, 3, sdf), TsdfSampler::Sample::observed);
   EXPECT_EQ(sampler.voxel(19, 3, 3, sdf), TsdfSampler::Sample::unallocated);
   EXPECT_EQ(sampler.voxel(3, 3, 3, sdf), TsdfSampler::Sample::observed);
+}
+
+// The lines that a stencil's prefetch asks for (the observation grid's surface refreshes):
+// exactly those holding a voxel of rows y0..y1 in slices z0..z1, by the voxels' byte offsets.
+TEST(TsdfVolume, DistanceLinesAreTheLinesHoldingTheRowsOfTheSlices) {
+  EXPECT_EQ(TsdfVolume::distance_lines(0, 1, 0, 0), 0x1u);
+  EXPECT_EQ(TsdfVolume::distance_lines(1, 2, 0, 0), 0x3u);
+  EXPECT_EQ(TsdfVolume::distance_lines(0, 7, 1, 1), 0xf0u);
+  EXPECT_EQ(TsdfVolume::distance_lines(0, 7, 0, 7), 0xffffffffu);
+  for (int y0 = 0; y0 < kBlockSide; ++y0)
+    for (int y1 = y0; y1 < kBlockSide; ++y1)
+      for (int z0 = 0; z0 < kBlockSide; z0 += 3)
+        for (int z1 = z0; z1 < kBlockSide; z1 += 2) {
+          std::uint32_t expected = 0;
+          for (int z = z0; z <= z1; ++z)
+            for (int y = y0; y <= y1; ++y)
+              for (int x = 0; x < kBlockSide; ++x)
+                expected |= 1u << (voxel_in_block(x, y, z) * int(sizeof(float)) / 64);
+          EXPECT_EQ(TsdfVolume::distance_lines(y0, y1, z0, z1), expected)
+              << "rows " << y0 << ".." << y1 << ", slices " << z0 << ".." << z1;
+        }
 }
 
 TEST(BlockOccupancy, HoldsEveryAllocatedBlockAndRulesOutTheRest) {
