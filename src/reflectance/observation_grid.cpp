@@ -101,11 +101,6 @@ void ObservationGrid::prefetch_voxel_state(int block) const {
 }
 
 void ObservationGrid::GeometryReads::add(const Eigen::Vector3i& block, std::uint32_t block_lines) {
-  for (int i = 0; i < count; ++i)
-    if (blocks[std::size_t(i)] == block) {
-      lines[std::size_t(i)] |= block_lines;
-      return;
-    }
   if (count == kCapacity) return;
   blocks[std::size_t(count)] = block;
   lines[std::size_t(count++)] = block_lines;
@@ -115,35 +110,42 @@ void ObservationGrid::geometry_reads_due(int block, int frame, float inverse_geo
                                          GeometryReads& reads) const {
   // A refresh first reads the 4^3 TSDF voxels from floor(p) - 1 on around its start p, the
   // surface point or (without one) the voxel centre (TsdfSampler::trilinear_with_gradient). Only
-  // those lines are asked for: the whole 2 KB of the block under the voxel and of the up to seven
-  // its stencils might reach was 8 x 32 lines for a few dozen read, and those prefetches stalled
-  // on the full line-fill buffers (perf, cubes at 2 cm: half of the visibility pass's samples).
-  // A second Newton step from a voxel centre reads around its landing point, when it is read.
+  // the lines of the box that holds those stencils are asked for: the whole 2 KB of the block
+  // under the observation block and of the up to seven its stencils might reach was 8 x 32
+  // lines where a refresh or two reads a few dozen, and those prefetches stalled on the full
+  // line-fill buffers (perf, cubes at 2 cm: half of the visibility pass's samples). (Each
+  // stencil's own lines instead of their box: as fast at 2 cm, slower at 1 cm, where a block
+  // has more refreshes due and most of the box is read anyway.) A second Newton step from a
+  // voxel centre reads around its landing point, unprefetched.
   reads.count = 0;
   const int first = block * voxels_per_block_;
   const Eigen::Vector3i first_voxel = hash_.block(block) * side_;
-  constexpr int kShift = 3;  // TSDF voxel -> block: floor division by kBlockSide
-  static_assert(fusion::kBlockSide == 1 << kShift);
+  // The box of TSDF voxels that holds every due voxel's stencil.
+  Eigen::Vector3i low = Eigen::Vector3i::Constant(std::numeric_limits<int>::max());
+  Eigen::Vector3i high = Eigen::Vector3i::Constant(std::numeric_limits<int>::min());
   for (int local = 0; local < voxels_per_block_; ++local) {
     const int v = first + local;
     if (frame < next_refresh_frame_[v]) continue;
     const Eigen::Vector3f start =
         (has_surface_[v] ? position_[v] : voxel_centre(first_voxel + local_coordinates(local))) *
         inverse_geometry_voxel;
-    const Eigen::Vector3i low(int(std::floor(start.x())) - 1, int(std::floor(start.y())) - 1,
-                              int(std::floor(start.z())) - 1);
-    const Eigen::Vector3i high = low + Eigen::Vector3i::Constant(3);
-    for (int bz = low.z() >> kShift; bz <= high.z() >> kShift; ++bz)
-      for (int by = low.y() >> kShift; by <= high.y() >> kShift; ++by)
-        for (int bx = low.x() >> kShift; bx <= high.x() >> kShift; ++bx) {
-          const auto in_block = [](int value, int b) {
-            return std::clamp(value - (b << kShift), 0, fusion::kBlockSide - 1);
-          };
-          reads.add({bx, by, bz}, fusion::TsdfVolume::distance_lines(
-                                      in_block(low.y(), by), in_block(high.y(), by),
-                                      in_block(low.z(), bz), in_block(high.z(), bz)));
-        }
+    const Eigen::Vector3i cell(int(std::floor(start.x())), int(std::floor(start.y())),
+                               int(std::floor(start.z())));
+    low = low.cwiseMin(cell - Eigen::Vector3i::Ones());
+    high = high.cwiseMax(cell + Eigen::Vector3i::Constant(2));
   }
+  if (low.x() > high.x()) return;  // none due
+  constexpr int kShift = 3;        // TSDF voxel -> block: floor division by kBlockSide
+  static_assert(fusion::kBlockSide == 1 << kShift);
+  const auto in_block = [](int value, int b) {
+    return std::clamp(value - (b << kShift), 0, fusion::kBlockSide - 1);
+  };
+  for (int bz = low.z() >> kShift; bz <= high.z() >> kShift; ++bz)
+    for (int by = low.y() >> kShift; by <= high.y() >> kShift; ++by)
+      for (int bx = low.x() >> kShift; bx <= high.x() >> kShift; ++bx)
+        reads.add({bx, by, bz}, fusion::TsdfVolume::distance_lines(
+                                    in_block(low.y(), by), in_block(high.y(), by),
+                                    in_block(low.z(), bz), in_block(high.z(), bz)));
 }
 
 ObservationGrid::ObservationGrid(const ObservationGridParams& params)

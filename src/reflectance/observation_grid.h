@@ -197,9 +197,10 @@ class ObservationGrid {
   // Prefetches the per-voxel state collect() reads first for the voxels of `block`.
   void prefetch_voxel_state(int block) const;
   // The TSDF (geometry) blocks and, per block, the cache lines of its distances that the first
-  // reads of a block's due surface refreshes touch (fusion::TsdfVolume::distance_lines).
+  // reads of an observation block's due surface refreshes touch (the box around their
+  // stencils; fusion::TsdfVolume::distance_lines).
   struct GeometryReads {
-    static constexpr int kCapacity = 16;  // more are not prefetched (read when needed)
+    static constexpr int kCapacity = 27;  // 3^3; more are not prefetched (read when needed)
     int count = 0;
     std::array<Eigen::Vector3i, kCapacity> blocks;
     std::array<std::uint32_t, kCapacity> lines;
