@@ -103,10 +103,6 @@ class TsdfSampler {
                 lerp(lerp(corner[4], corner[5], fx), lerp(corner[6], corner[7], fx), fy), fz);
   }
   static int round_to_int(float value) { return static_cast<int>(std::floor(value + 0.5f)); }
-  // Block coordinates of a voxel: floor division by the block side, as a shift.
-  static constexpr int kBlockShift = 3;
-  static_assert(kBlockSide == 1 << kBlockShift);
-
   // Reads voxel (x0 + a, y0 + b, z0 + c) into box[a][b][c] for each (a, b, c) that wanted()
   // names; false when one of them is unallocated or unobserved. A box of at most a block's side
   // spans at most two blocks along each axis: their (at most 8) look-ups are made once, and each

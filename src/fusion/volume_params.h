@@ -4,8 +4,10 @@
 
 namespace glint::fusion {
 
-// Voxels per block side: blocks are 8x8x8 voxels (VoxelHashing's SDF_BLOCK_SIZE).
-inline constexpr int kBlockSide = 8;
+// Voxels per block side: blocks are 8x8x8 voxels (VoxelHashing's SDF_BLOCK_SIZE). A voxel's
+// block coordinate is its coordinate >> kBlockShift (floor division, also below zero).
+inline constexpr int kBlockShift = 3;
+inline constexpr int kBlockSide = 1 << kBlockShift;
 inline constexpr int kVoxelsPerBlock = kBlockSide * kBlockSide * kBlockSide;
 
 struct VolumeParams {

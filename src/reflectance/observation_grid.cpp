@@ -135,14 +135,13 @@ void ObservationGrid::geometry_reads_due(int block, int frame, float inverse_geo
     high = high.cwiseMax(cell + Eigen::Vector3i::Constant(2));
   }
   if (low.x() > high.x()) return;  // none due
-  constexpr int kShift = 3;        // TSDF voxel -> block: floor division by kBlockSide
-  static_assert(fusion::kBlockSide == 1 << kShift);
+  using fusion::kBlockShift;
   const auto in_block = [](int value, int b) {
-    return std::clamp(value - (b << kShift), 0, fusion::kBlockSide - 1);
+    return std::clamp(value - (b << kBlockShift), 0, fusion::kBlockSide - 1);
   };
-  for (int bz = low.z() >> kShift; bz <= high.z() >> kShift; ++bz)
-    for (int by = low.y() >> kShift; by <= high.y() >> kShift; ++by)
-      for (int bx = low.x() >> kShift; bx <= high.x() >> kShift; ++bx)
+  for (int bz = low.z() >> kBlockShift; bz <= high.z() >> kBlockShift; ++bz)
+    for (int by = low.y() >> kBlockShift; by <= high.y() >> kBlockShift; ++by)
+      for (int bx = low.x() >> kBlockShift; bx <= high.x() >> kBlockShift; ++bx)
         reads.add({bx, by, bz}, fusion::TsdfVolume::distance_lines(
                                     in_block(low.y(), by), in_block(high.y(), by),
                                     in_block(low.z(), bz), in_block(high.z(), bz)));
