@@ -87,6 +87,18 @@ std::vector<Observation> along_path(std::vector<Observation> observations) {
   return observations;
 }
 
+// One voxel's observation slots and their nearest-observation entries.
+struct VoxelSlots {
+  explicit VoxelSlots(int capacity) : slots(capacity), similarity(capacity), nearest(capacity) {}
+  int insert(InsertionKernel kernel, int count, const Observation& added) {
+    return insert_observation(kernel, slots.data(), {similarity.data(), nearest.data()}, count,
+                              int(slots.size()), added);
+  }
+  std::vector<Observation> slots;
+  std::vector<float> similarity;
+  std::vector<std::uint8_t> nearest;
+};
+
 // Arg 0: 0 = each new direction drawn at random over the hemisphere; 1 = along a camera path:
 // the dropped observation is then mostly the newest stored one. Both cycle through 64 voxels so
 // that the branch predictor cannot learn one voxel's comparisons. Arg 1: the kernel.
@@ -94,14 +106,11 @@ void InsertIntoFullVoxel(benchmark::State& state) {
   InsertionKernel kernel;
   if (!with_kernel(state, 1, kernel)) return;
   constexpr int kVoxels = 64;
-  std::vector<std::vector<Observation>> slots(kVoxels);
-  std::vector<std::vector<NearestObservation>> nearest(kVoxels);
+  std::vector<VoxelSlots> voxels(kVoxels, VoxelSlots(30));
   for (int v = 0; v < kVoxels; ++v) {
-    slots[v].resize(30);
-    nearest[v].resize(30);
     int count = 0;
     for (const Observation& o : random_observations(30, 3 + v))
-      count = insert_observation(kernel, slots[v].data(), nearest[v].data(), count, 30, o);
+      count = voxels[v].insert(kernel, count, o);
   }
   std::vector<Observation> incoming = random_observations(1024, 4);
   if (state.range(0) == 1) incoming = along_path(incoming);
@@ -111,8 +120,7 @@ void InsertIntoFullVoxel(benchmark::State& state) {
     const Observation& next_seen = incoming[(next / kVoxels) % incoming.size()];
     const Observation added(next_seen.colour(), next_seen.direction(), std::uint32_t(100 + next));
     ++next;
-    benchmark::DoNotOptimize(
-        insert_observation(kernel, slots[v].data(), nearest[v].data(), 30, 30, added));
+    benchmark::DoNotOptimize(voxels[v].insert(kernel, 30, added));
   }
 }
 BENCHMARK(InsertIntoFullVoxel)->ArgsProduct({{0, 1}, {0, 1, 2}})->Unit(benchmark::kNanosecond);
@@ -123,12 +131,10 @@ void InsertIntoFillingVoxel(benchmark::State& state) {
   InsertionKernel kernel;
   if (!with_kernel(state, 0, kernel)) return;
   const std::vector<Observation> incoming = along_path(random_observations(30, 5));
-  std::vector<Observation> slots(30);
-  std::vector<NearestObservation> nearest(30);
+  VoxelSlots voxel(30);
   for (auto _ : state) {
     int count = 0;
-    for (const Observation& o : incoming)
-      count = insert_observation(kernel, slots.data(), nearest.data(), count, 30, o);
+    for (const Observation& o : incoming) count = voxel.insert(kernel, count, o);
     benchmark::DoNotOptimize(count);
   }
   state.SetItemsProcessed(state.iterations() * std::int64_t(incoming.size()));

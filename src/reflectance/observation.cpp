@@ -40,6 +40,12 @@ struct ObservationLanes {
 
 namespace {
 
+// An observation's most similar other one (an entry of NearestObservations).
+struct Nearest {
+  float similarity = -2.0f;
+  std::uint8_t slot = 0;
+};
+
 // A full voxel's insertion is 60-90 direction dot products and a few searches for the most
 // similar one, whose winner is as good as random to the branch predictor; they run scalar
 // (Scalar), 8 at a time with AVX2 (Avx2) or 16 at a time with AVX-512 (Avx512). All give the
@@ -50,8 +56,8 @@ struct Scalar {
     for (int j = 0; j < count; ++j) out[j] = to.similarity(slots[j]);
   }
   // The first largest of values[0, count) above -2, and its index; {-2, 0} when there is none.
-  static NearestObservation first_largest(const float* values, int count) {
-    NearestObservation best;
+  static Nearest first_largest(const float* values, int count) {
+    Nearest best;
     for (int j = 0; j < count; ++j)
       if (values[j] > best.similarity) best = {values[j], std::uint8_t(j)};
     return best;
@@ -93,8 +99,7 @@ struct Avx512 {
   }
 
   // The largest value first, then the first lane that holds it.
-  [[gnu::target("arch=x86-64-v4")]] static NearestObservation first_largest(const float* values,
-                                                                            int count) {
+  [[gnu::target("arch=x86-64-v4")]] static Nearest first_largest(const float* values, int count) {
     const __m512 floor = _mm512_set1_ps(-2.0f);
     __m512 largest = floor;
     for (int first = 0; first < count; first += 16)
@@ -157,8 +162,7 @@ struct Avx2 {
   }
 
   // The largest value first, then the first lane that holds it.
-  [[gnu::target("arch=x86-64-v3")]] static NearestObservation first_largest(const float* values,
-                                                                            int count) {
+  [[gnu::target("arch=x86-64-v3")]] static Nearest first_largest(const float* values, int count) {
     __m256 largest = _mm256_set1_ps(-2.0f);
     for (int first = 0; first < count; first += 8)
       largest = _mm256_max_ps(largest, load(values + first, count - first));
@@ -196,8 +200,7 @@ constexpr int kSimilarityCapacity = (kMaxObservationsPerVoxel + 15) / 16 * 16;
 
 // The nearest other observation of slot i among slots[0, count).
 template <class Simd>
-[[gnu::always_inline]] inline NearestObservation nearest_of(const Observation* slots, int count,
-                                                            int i) {
+[[gnu::always_inline]] inline Nearest nearest_of(const Observation* slots, int count, int i) {
   float similarity[kSimilarityCapacity];
   Simd::similarities(slots, count, slots[i], similarity);
   similarity[i] = -2.0f;  // not its own nearest
@@ -207,22 +210,29 @@ template <class Simd>
 // Stores `added` in slot r (a new slot when r == count) and updates every nearest entry;
 // `similarity[j]` = added . slots[j] for the other slots (similarity[r] is overwritten).
 template <class Simd>
-[[gnu::always_inline]] inline void place(Observation* slots, NearestObservation* nearest, int count,
+[[gnu::always_inline]] inline void place(Observation* slots, NearestObservations nearest, int count,
                                          int r, const Observation& added, float* similarity) {
   slots[r] = added;
   similarity[r] = -2.0f;
-  nearest[r] = Simd::first_largest(similarity, count);
+  const Nearest own = Simd::first_largest(similarity, count);
+  nearest.similarity[r] = own.similarity;
+  nearest.slot[r] = own.slot;
   for (int i = 0; i < count; ++i) {
     if (i == r) continue;
-    if (nearest[i].slot == r && nearest[i].similarity > -2.0f)
-      nearest[i] = nearest_of<Simd>(slots, count, i);  // its nearest was replaced
-    else if (similarity[i] > nearest[i].similarity)
-      nearest[i] = {similarity[i], std::uint8_t(r)};
+    Nearest updated;
+    if (nearest.slot[i] == r && nearest.similarity[i] > -2.0f)
+      updated = nearest_of<Simd>(slots, count, i);  // its nearest was replaced
+    else if (similarity[i] > nearest.similarity[i])
+      updated = {similarity[i], std::uint8_t(r)};
+    else
+      continue;
+    nearest.similarity[i] = updated.similarity;
+    nearest.slot[i] = updated.slot;
   }
 }
 
 template <class Simd>
-[[gnu::always_inline]] inline int insert(Observation* slots, NearestObservation* nearest, int count,
+[[gnu::always_inline]] inline int insert(Observation* slots, NearestObservations nearest, int count,
                                          int capacity, const Observation& added) {
   float similarity[kSimilarityCapacity];
   Simd::similarities(slots, count, added, similarity);
@@ -231,9 +241,7 @@ template <class Simd>
     return count + 1;
   }
   // The most similar stored pair, and the stored observation most similar to the new one.
-  float pair_similarity[kSimilarityCapacity];
-  for (int i = 0; i < capacity; ++i) pair_similarity[i] = nearest[i].similarity;
-  const NearestObservation pair = Simd::first_largest(pair_similarity, capacity);
+  const Nearest pair = Simd::first_largest(nearest.similarity, capacity);
   const int first = pair.slot, closest_to_new = Simd::first_largest(similarity, capacity).slot;
   int dropped;
   if (similarity[closest_to_new] > pair.similarity) {
@@ -241,30 +249,30 @@ template <class Simd>
     if (added.frame() < slots[closest_to_new].frame()) return capacity;
     dropped = closest_to_new;
   } else {
-    const int second = nearest[first].slot;
+    const int second = nearest.slot[first];
     dropped = slots[first].frame() <= slots[second].frame() ? first : second;
   }
   place<Simd>(slots, nearest, capacity, dropped, added, similarity);
   return capacity;
 }
 
-using InsertKernel = int (*)(Observation*, NearestObservation*, int, int, const Observation&);
+using InsertKernel = int (*)(Observation*, NearestObservations, int, int, const Observation&);
 
-[[gnu::flatten]] int insert_baseline(Observation* slots, NearestObservation* nearest, int count,
+[[gnu::flatten]] int insert_baseline(Observation* slots, NearestObservations nearest, int count,
                                      int capacity, const Observation& added) {
   return insert<Scalar>(slots, nearest, count, capacity, added);
 }
 
 #if defined(__x86_64__)
 [[gnu::target("arch=x86-64-v3"), gnu::flatten]] int insert_x86_64_v3(Observation* slots,
-                                                                     NearestObservation* nearest,
+                                                                     NearestObservations nearest,
                                                                      int count, int capacity,
                                                                      const Observation& added) {
   return insert<Avx2>(slots, nearest, count, capacity, added);
 }
 
 [[gnu::target("arch=x86-64-v4"), gnu::flatten]] int insert_x86_64_v4(Observation* slots,
-                                                                     NearestObservation* nearest,
+                                                                     NearestObservations nearest,
                                                                      int count, int capacity,
                                                                      const Observation& added) {
   return insert<Avx512>(slots, nearest, count, capacity, added);
@@ -295,13 +303,13 @@ std::vector<InsertionKernel> supported_insertion_kernels() {
   return kernels;
 }
 
-int insert_observation(InsertionKernel kernel, Observation* slots, NearestObservation* nearest,
+int insert_observation(InsertionKernel kernel, Observation* slots, NearestObservations nearest,
                        int count, int capacity, const Observation& added) {
   if (capacity <= 0) return 0;
   return kernel_of(kernel)(slots, nearest, count, capacity, added);
 }
 
-int insert_observation(Observation* slots, NearestObservation* nearest, int count, int capacity,
+int insert_observation(Observation* slots, NearestObservations nearest, int count, int capacity,
                        const Observation& added) {
   if (capacity <= 0) return 0;
   static const InsertKernel kernel = kernel_of(supported_insertion_kernels().back());

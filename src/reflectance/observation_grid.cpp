@@ -84,8 +84,10 @@ void ObservationGrid::prefetch_voxel(int v) const {
 void ObservationGrid::prefetch_observations(int v, bool for_insertion) const {
   const std::size_t first = first_slot(v);
   prefetch_lines(observations_.get() + first, observation_count_[v] * sizeof(Observation));
-  if (for_insertion)
-    prefetch_lines(nearest_.get() + first, observation_count_[v] * sizeof(NearestObservation));
+  if (for_insertion) {
+    prefetch_lines(nearest_similarity_.get() + first, observation_count_[v] * sizeof(float));
+    prefetch_lines(nearest_slot_.get() + first, observation_count_[v] * sizeof(std::uint8_t));
+  }
 }
 
 void ObservationGrid::prefetch_voxel_state(int block) const {
@@ -171,7 +173,8 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
     throw Error("observation grid", "spacing_max_frames", "must be >= 0");
   const std::size_t voxels = hash_.capacity() * voxels_per_block_;
   observations_ = voxel_pool<Observation>(voxels * params.observations_per_voxel);
-  nearest_ = voxel_pool<NearestObservation>(voxels * params.observations_per_voxel);
+  nearest_similarity_ = voxel_pool<float>(voxels * params.observations_per_voxel);
+  nearest_slot_ = voxel_pool<std::uint8_t>(voxels * params.observations_per_voxel);
   observation_set_ = voxel_pool<std::int32_t>(voxels);
   observation_count_ = voxel_pool<std::uint8_t>(voxels);
   newest_ = voxel_pool<NewestObservation>(voxels);
@@ -449,9 +452,10 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
         if (observation_set_[v] == 0)
           observation_set_[v] = 1 + observation_sets_used_.fetch_add(1, std::memory_order_relaxed);
         const std::size_t first = first_slot(v);
-        observation_count_[v] =
-            std::uint8_t(insert_observation(observations_.get() + first, nearest_.get() + first,
-                                            observation_count_[v], capacity, observation));
+        observation_count_[v] = std::uint8_t(
+            insert_observation(observations_.get() + first,
+                               {nearest_similarity_.get() + first, nearest_slot_.get() + first},
+                               observation_count_[v], capacity, observation));
         newest_[v] = {voxel.direction, frame};
         visible_[voxel.visible_index] = {v, voxel.pixel};
       }

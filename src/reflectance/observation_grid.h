@@ -49,7 +49,7 @@ struct ObservationGridParams {
   // Pool size; exhaustion is a glint::Error. 0: 2^20 voxels at 2 cm and above, and
   // 2 (0.02 / voxel_size_m)^2 times that below (a surface holds (0.02 / v)^2 times as many
   // voxels, and finer grids leave more of each block empty). About 60 bytes per voxel and
-  // 720 bytes of observation slots per voxel that has been observed, committed as they are used.
+  // 630 bytes of observation slots per voxel that has been observed, committed as they are used.
   std::size_t voxel_capacity = 0;
   int allocation_stride_px = 2;       // every n-th pixel of every n-th row allocates
   double depth_tolerance_m = 0.01;    // |measured - voxel depth| allowed, plus ...
@@ -229,7 +229,8 @@ class ObservationGrid {
   // observation, in the order voxels are first seen: most voxels of a block never see the
   // surface, and slots reserved for every voxel had the kernel zeroing ~1 KB for each of them.
   PoolArray<Observation> observations_;
-  PoolArray<NearestObservation> nearest_;    // parallel to observations_
+  PoolArray<float> nearest_similarity_;  // NearestObservations, parallel to observations_
+  PoolArray<std::uint8_t> nearest_slot_;
   PoolArray<std::int32_t> observation_set_;  // 1 + its set of slots, 0 = none yet
   std::atomic<std::int32_t> observation_sets_used_{0};
   PoolArray<std::uint8_t> observation_count_;

@@ -18,15 +18,19 @@ Observation seen_from(float theta, float phi, std::uint32_t frame) {
 
 // A voxel's slots with their nearest-neighbour bookkeeping.
 struct Voxel {
-  explicit Voxel(int capacity) : slots(capacity), nearest(capacity), capacity(capacity) {}
+  explicit Voxel(int capacity)
+      : slots(capacity), similarity(capacity), nearest(capacity), capacity(capacity) {}
   void insert(const Observation& o) {
-    count = insert_observation(slots.data(), nearest.data(), count, capacity, o);
+    count =
+        insert_observation(slots.data(), {similarity.data(), nearest.data()}, count, capacity, o);
   }
   void insert(InsertionKernel kernel, const Observation& o) {
-    count = insert_observation(kernel, slots.data(), nearest.data(), count, capacity, o);
+    count = insert_observation(kernel, slots.data(), {similarity.data(), nearest.data()}, count,
+                               capacity, o);
   }
   std::vector<Observation> slots;
-  std::vector<NearestObservation> nearest;
+  std::vector<float> similarity;      // of each slot's nearest
+  std::vector<std::uint8_t> nearest;  // its slot
   int capacity, count = 0;
 };
 
@@ -138,8 +142,8 @@ TEST(Observations, EveryInsertionKernelKeepsTheSameSlotsAndNearestEntries) {
         for (int i = 0; i < voxels[0].count; ++i) {
           ASSERT_EQ(voxels[k].slots[i].frame(), voxels[0].slots[i].frame())
               << "kernel " << int(kernels[k]) << " capacity " << capacity << " frame " << f;
-          ASSERT_EQ(voxels[k].nearest[i].similarity, voxels[0].nearest[i].similarity);
-          ASSERT_EQ(voxels[k].nearest[i].slot, voxels[0].nearest[i].slot);
+          ASSERT_EQ(voxels[k].similarity[i], voxels[0].similarity[i]);
+          ASSERT_EQ(voxels[k].nearest[i], voxels[0].nearest[i]);
         }
       }
     }
