@@ -413,8 +413,13 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
   const int width = depth_m.width(), height = depth_m.height();
   const float* depth = depth_m.plane(0);
 
-  // One slot per voxel of the frame's blocks; -1 = not observed.
-  visible_.assign(frame_blocks_.size() * voxels_per_block_, VisibleVoxel{-1, -1});
+  // Each frame block's observed voxels go to its own range of voxels_per_block_ entries, in
+  // voxel order, and are gathered after the pass. (One entry per voxel, cleared each frame and
+  // then compacted, was 6 MB written and scanned on one core per frame at 1 cm, where 13 % of
+  // the voxels have a surface.)
+  const std::size_t entries = frame_blocks_.size() * voxels_per_block_;
+  if (visible_by_block_.size() < entries) visible_by_block_.resize(entries);
+  visible_in_block_.assign(frame_blocks_.size(), 0);
   // The voxels go in two passes: the first refreshes surfaces, tests visibility and prefetches
   // the observation slots of the visible voxels; the second inserts. Insertion reads every
   // stored direction of a voxel (~1 KB), so the misses of a batch of voxels then overlap
@@ -457,7 +462,7 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
                                {nearest_similarity_.get() + first, nearest_slot_.get() + first},
                                observation_count_[v], capacity, observation));
         newest_[v] = {voxel.direction, frame};
-        visible_[voxel.visible_index] = {v, voxel.pixel};
+        visible_by_block_[voxel.visible_index] = {v, voxel.pixel};
       }
       pending = 0;
     };
@@ -520,6 +525,7 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
         projection.z = q.z();
         __builtin_prefetch(depth + projection.pixel);
       }
+      int observed = 0;  // of this block's voxels, so far
       for (int local = 0; local < voxels_per_block_; ++local) {
         const Projection& projection = projections[local];
         if (projection.pixel < 0) continue;
@@ -534,15 +540,17 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
         if (normal_[v].dot(direction) < float(params_.min_view_cosine)) continue;
         if (observation_count_[v] > 0 && direction.dot(newest_[v].direction) > spacing_cosine &&
             frame - newest_[v].frame < spacing_max_frames) {
-          visible_[int(slot) * voxels_per_block_ + local] = {v, projection.pixel};
+          visible_by_block_[slot * voxels_per_block_ + observed++] = {v, projection.pixel};
           continue;
         }
         prefetch_observations(v, true);
         // Its colour is read at insertion, a batch later: ask for it now (three planes).
         for (int channel = 0; channel < 3; ++channel)
           __builtin_prefetch(colour.plane(channel) + projection.pixel);
-        seen[pending++] = {v, int(slot) * voxels_per_block_ + local, projection.pixel, direction};
+        seen[pending++] = {v, int(slot) * voxels_per_block_ + observed++, projection.pixel,
+                           direction};
       }
+      visible_in_block_[slot] = observed;
     }
     insert_pending();
   });
@@ -557,7 +565,11 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
     parallel_for(refit_blocks_.size(),
                  [&](std::size_t i) { fit_normals_to_neighbours(refit_blocks_[i], frame); });
   }
-  std::erase_if(visible_, [](const VisibleVoxel& seen) { return seen.voxel < 0; });
+  visible_.clear();
+  for (std::size_t slot = 0; slot < blocks; ++slot) {
+    const auto first = visible_by_block_.begin() + std::ptrdiff_t(slot * voxels_per_block_);
+    visible_.insert(visible_.end(), first, first + visible_in_block_[slot]);
+  }
   return visible_;
 }
 

@@ -249,6 +249,10 @@ class ObservationGrid {
   PoolArray<bool> has_refined_kd_, refined_kd_reliable_;
 
   std::vector<VisibleVoxel> visible_;
+  // collect()'s scratch: per frame block, voxels_per_block_ entries of which the first
+  // visible_in_block_[slot] are its observed voxels.
+  std::vector<VisibleVoxel> visible_by_block_;
+  std::vector<int> visible_in_block_;
 };
 
 }  // namespace glint::reflectance
