@@ -194,7 +194,9 @@ class ObservationGrid {
   // Replaces the gradient normals of the voxels of frame_blocks_[slot] refreshed in `frame` by
   // the plane through their neighbours' surface points (ObservationGridParams).
   void fit_normals_to_neighbours(std::size_t slot, int frame);
-  // Prefetches the per-voxel state collect() reads first for the voxels of `block`.
+  // Prefetch the per-voxel state collect() reads first for the voxels of `block`: their refresh
+  // frames and surface flags, then (a block later, reading the flags) the rest.
+  void prefetch_surface_flags(int block) const;
   void prefetch_voxel_state(int block) const;
   // The TSDF (geometry) blocks and, per block, the cache lines of its distances that the first
   // reads of an observation block's due surface refreshes touch (the box around their
