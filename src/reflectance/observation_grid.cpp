@@ -384,6 +384,13 @@ void ObservationGrid::refresh_surface(int v, const Eigen::Vector3f& centre, int 
   normal_[v] = gradient.normalized();
 }
 
+void ObservationGrid::prefetch_neighbour_slots(std::size_t slot) const {
+  const Eigen::Vector3i block = hash_.block(frame_blocks_[slot]);
+  for (int z = -1; z <= 1; ++z)
+    for (int y = -1; y <= 1; ++y)
+      for (int x = -1; x <= 1; ++x) hash_.prefetch(block + Eigen::Vector3i(x, y, z));
+}
+
 void ObservationGrid::fit_normals_to_neighbours(std::size_t slot, int frame) {
   const int block = frame_blocks_[slot];
   const int first_voxel = block * voxels_per_block_;
@@ -395,12 +402,11 @@ void ObservationGrid::fit_normals_to_neighbours(std::size_t slot, int frame) {
   if (first == voxels_per_block_) return;  // the 27 block look-ups would serve no voxel
 
   // The 3^3 blocks around this one, looked up once for all of its voxels (their hash slots
-  // prefetched first, so that the misses overlap).
+  // were prefetched a block earlier: prefetch_neighbour_slots).
   const Eigen::Vector3i block_coordinates = hash_.block(block);
   const auto neighbour = [&](int i) -> Eigen::Vector3i {
     return block_coordinates + Eigen::Vector3i(i % 3 - 1, (i / 3) % 3 - 1, i / 9 - 1);
   };
-  for (int i = 0; i < 27; ++i) hash_.prefetch(neighbour(i));
   std::array<int, 27> around;
   for (int i = 0; i < 27; ++i) around[i] = hash_.find(neighbour(i));
   const Eigen::Vector3i origin = (block_coordinates - Eigen::Vector3i::Ones()) * side_;
@@ -606,8 +612,13 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
     refit_blocks_.clear();
     for (std::size_t slot = 0; slot < blocks; ++slot)
       if (block_refreshed_[slot]) refit_blocks_.push_back(slot);
-    parallel_for(refit_blocks_.size(),
-                 [&](std::size_t i) { fit_normals_to_neighbours(refit_blocks_[i], frame); });
+    parallel_for_chunks(refit_blocks_.size(), 16, [&](std::size_t begin, std::size_t end) {
+      prefetch_neighbour_slots(refit_blocks_[begin]);
+      for (std::size_t i = begin; i < end; ++i) {
+        if (i + 1 < end) prefetch_neighbour_slots(refit_blocks_[i + 1]);
+        fit_normals_to_neighbours(refit_blocks_[i], frame);
+      }
+    });
   }
   visible_.clear();
   for (std::size_t slot = 0; slot < blocks; ++slot) {

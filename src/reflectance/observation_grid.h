@@ -194,6 +194,9 @@ class ObservationGrid {
   // Replaces the gradient normals of the voxels of frame_blocks_[slot] refreshed in `frame` by
   // the plane through their neighbours' surface points (ObservationGridParams).
   void fit_normals_to_neighbours(std::size_t slot, int frame);
+  // Prefetches the hash slots of the 3^3 blocks around frame_blocks_[slot], which
+  // fit_normals_to_neighbours() looks up.
+  void prefetch_neighbour_slots(std::size_t slot) const;
   // Prefetch the per-voxel state collect() reads first for the voxels of `block`: their refresh
   // frames and surface flags, then (a block later, reading the flags) the rest.
   void prefetch_surface_flags(int block) const;
