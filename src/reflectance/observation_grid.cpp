@@ -386,34 +386,41 @@ void ObservationGrid::refresh_surface(int v, const Eigen::Vector3f& centre, int 
 
 void ObservationGrid::prefetch_neighbour_slots(std::size_t slot) const {
   const Eigen::Vector3i block = hash_.block(frame_blocks_[slot]);
-  for (int z = -1; z <= 1; ++z)
-    for (int y = -1; y <= 1; ++y)
-      for (int x = -1; x <= 1; ++x) hash_.prefetch(block + Eigen::Vector3i(x, y, z));
+  for (int i = 0; i < 27; ++i) hash_.prefetch(block + neighbour_offset(i));
 }
 
-void ObservationGrid::fit_normals_to_neighbours(std::size_t slot, int frame) {
+void ObservationGrid::find_neighbours(std::size_t slot, NeighbourBlocks& around) const {
+  const Eigen::Vector3i block = hash_.block(frame_blocks_[slot]);
+  for (int i = 0; i < 27; ++i) around[std::size_t(i)] = hash_.find(block + neighbour_offset(i));
+}
+
+void ObservationGrid::prefetch_refit_state(const NeighbourBlocks& around) const {
+  const std::size_t voxels = voxels_per_block_;
+  for (int i = 0; i < 27; ++i) {
+    if (around[std::size_t(i)] < 0) continue;
+    const std::size_t first = std::size_t(around[std::size_t(i)]) * voxels;
+    prefetch_lines(has_surface_.get() + first, voxels * sizeof(bool));
+    if (i != 13) continue;  // the block itself: the refit reads all of its voxels' state
+    prefetch_lines(next_refresh_frame_.get() + first, voxels * sizeof(int));
+    prefetch_lines(surface_settled_.get() + first, voxels * sizeof(std::uint8_t));
+    prefetch_lines(position_.get() + first, voxels * sizeof(Eigen::Vector3f));
+    prefetch_lines(normal_.get() + first, voxels * sizeof(Eigen::Vector3f));
+  }
+}
+
+void ObservationGrid::fit_normals_to_neighbours(std::size_t slot, int frame,
+                                                const NeighbourBlocks& around) {
   const int block = frame_blocks_[slot];
   const int first_voxel = block * voxels_per_block_;
   const auto refreshed = [&](int v) {  // in this frame's collect(), and found the surface
     return has_surface_[v] && next_refresh_frame_[v] == next_refresh(frame, 0, surface_settled_[v]);
   };
-  int first = 0;
-  while (first < voxels_per_block_ && !refreshed(first_voxel + first)) ++first;
-  if (first == voxels_per_block_) return;  // the 27 block look-ups would serve no voxel
-
-  // The 3^3 blocks around this one, looked up once for all of its voxels (their hash slots
-  // were prefetched a block earlier: prefetch_neighbour_slots).
   const Eigen::Vector3i block_coordinates = hash_.block(block);
-  const auto neighbour = [&](int i) -> Eigen::Vector3i {
-    return block_coordinates + Eigen::Vector3i(i % 3 - 1, (i / 3) % 3 - 1, i / 9 - 1);
-  };
-  std::array<int, 27> around;
-  for (int i = 0; i < 27; ++i) around[i] = hash_.find(neighbour(i));
   const Eigen::Vector3i origin = (block_coordinates - Eigen::Vector3i::Ones()) * side_;
   // Neighbours more than 30 degrees off the voxel's tangent plane belong to another face.
   const float max_off_plane = std::sin(float(M_PI) / 6);
 
-  for (int local = first; local < voxels_per_block_; ++local) {
+  for (int local = 0; local < voxels_per_block_; ++local) {
     const int v = first_voxel + local;
     if (!refreshed(v)) continue;
     const Eigen::Vector3f p = position_[v], gradient_normal = normal_[v];
@@ -612,11 +619,22 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
     refit_blocks_.clear();
     for (std::size_t slot = 0; slot < blocks; ++slot)
       if (block_refreshed_[slot]) refit_blocks_.push_back(slot);
+    // A software pipeline over the blocks: two ahead, the hash slots of the 3^3 blocks around;
+    // one ahead, their look-ups and the state the refit reads.
     parallel_for_chunks(refit_blocks_.size(), 16, [&](std::size_t begin, std::size_t end) {
-      prefetch_neighbour_slots(refit_blocks_[begin]);
+      std::array<NeighbourBlocks, 2> around;
+      for (std::size_t i = begin; i < std::min(begin + 2, end); ++i)
+        prefetch_neighbour_slots(refit_blocks_[i]);
+      find_neighbours(refit_blocks_[begin], around[0]);
+      prefetch_refit_state(around[0]);
       for (std::size_t i = begin; i < end; ++i) {
-        if (i + 1 < end) prefetch_neighbour_slots(refit_blocks_[i + 1]);
-        fit_normals_to_neighbours(refit_blocks_[i], frame);
+        const std::size_t current = (i - begin) % 2, next = 1 - current;
+        if (i + 2 < end) prefetch_neighbour_slots(refit_blocks_[i + 2]);
+        if (i + 1 < end) {
+          find_neighbours(refit_blocks_[i + 1], around[next]);
+          prefetch_refit_state(around[next]);
+        }
+        fit_normals_to_neighbours(refit_blocks_[i], frame, around[current]);
       }
     });
   }

@@ -23,6 +23,7 @@
 // committed as voxels are used.
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -191,12 +192,17 @@ class ObservationGrid {
   int next_refresh(int frame, int misses, int settled) const {
     return frame + (params_.geometry_refresh_frames << (misses > 0 ? misses - 1 : settled));
   }
+  // Pool indices (-1: none) of the 3^3 blocks around a block, neighbour_offset(i) from it.
+  using NeighbourBlocks = std::array<int, 27>;
+  static Eigen::Vector3i neighbour_offset(int i) { return {i % 3 - 1, (i / 3) % 3 - 1, i / 9 - 1}; }
   // Replaces the gradient normals of the voxels of frame_blocks_[slot] refreshed in `frame` by
-  // the plane through their neighbours' surface points (ObservationGridParams).
-  void fit_normals_to_neighbours(std::size_t slot, int frame);
-  // Prefetches the hash slots of the 3^3 blocks around frame_blocks_[slot], which
-  // fit_normals_to_neighbours() looks up.
+  // the plane through their neighbours' surface points (ObservationGridParams); `around` are
+  // the blocks around it (find_neighbours). Before it, in this order, some blocks ahead:
+  // prefetch_neighbour_slots(), find_neighbours() and prefetch_refit_state().
+  void fit_normals_to_neighbours(std::size_t slot, int frame, const NeighbourBlocks& around);
   void prefetch_neighbour_slots(std::size_t slot) const;
+  void find_neighbours(std::size_t slot, NeighbourBlocks& around) const;
+  void prefetch_refit_state(const NeighbourBlocks& around) const;
   // Prefetch the per-voxel state collect() reads first for the voxels of `block`: their refresh
   // frames and surface flags, then (a block later, reading the flags) the rest.
   void prefetch_surface_flags(int block) const;
