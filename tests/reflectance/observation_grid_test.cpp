@@ -117,7 +117,8 @@ TEST(ObservationGrid, OccludedAndFarVoxelsAreNotObserved) {
 }
 
 // Pool indices, and with them the order of a frame's voxels (which the segments' reservoirs and
-// samples follow), are handed out in image-row order whatever the threads do.
+// samples follow), are handed out in image-row order whatever the threads do; the surface points
+// and refitted normals do not depend on how the blocks were split among threads either.
 TEST(ObservationGrid, VoxelIndicesDoNotDependOnTheNumberOfThreads) {
   // A tilted wall seen from three poses: every frame allocates new blocks.
   const auto run = [](int threads) {
@@ -130,23 +131,30 @@ TEST(ObservationGrid, VoxelIndicesDoNotDependOnTheNumberOfThreads) {
     for (int y = 0; y < kCamera.height; ++y)
       for (int x = 0; x < kCamera.width; ++x) depth.at(x, y, 0) = 0.8f + 0.006f * float(x);
     const ImageF colour(kCamera.width, kCamera.height, 3, 0.25f);
-    std::vector<VisibleVoxel> all;
+    struct Seen {
+      VisibleVoxel voxel;
+      Eigen::Vector3f position, normal;
+    };
+    std::vector<Seen> all;
     for (int frame = 0; frame < 3; ++frame) {
       Pose pose = Pose::Identity();
       pose.translation() = Eigen::Vector3d(0.15 * frame, 0.05 * frame, 0);
       fusion::VisibleBlocks blocks;
       fusion::integrate(geometry, depth, colour, kCamera, pose, blocks);
-      const auto& visible = grid.collect(depth, colour, kCamera, pose, 1.0f, geometry, frame);
-      all.insert(all.end(), visible.begin(), visible.end());
+      for (const VisibleVoxel& seen :
+           grid.collect(depth, colour, kCamera, pose, 1.0f, geometry, frame))
+        all.push_back({seen, grid.position(seen.voxel), grid.normal(seen.voxel)});
     }
     return all;
   };
-  const std::vector<VisibleVoxel> one = run(1), many = run(0);
+  const auto one = run(1), many = run(0);
   ASSERT_GT(one.size(), 100u);
   ASSERT_EQ(one.size(), many.size());
   for (std::size_t i = 0; i < one.size(); ++i) {
-    EXPECT_EQ(one[i].voxel, many[i].voxel) << i;
-    EXPECT_EQ(one[i].pixel, many[i].pixel) << i;
+    EXPECT_EQ(one[i].voxel.voxel, many[i].voxel.voxel) << i;
+    EXPECT_EQ(one[i].voxel.pixel, many[i].voxel.pixel) << i;
+    EXPECT_EQ(one[i].position, many[i].position) << i;
+    EXPECT_EQ(one[i].normal, many[i].normal) << i;
   }
 }
 
