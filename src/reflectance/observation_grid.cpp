@@ -49,6 +49,27 @@ std::optional<Eigen::Vector3f> fit_plane(const Eigen::Vector3f* points, int coun
   return normal;
 }
 
+// Prefetches the lines holding elements i of `block_first` whose bit i is set in `elements`.
+template <class T>
+void prefetch_selected(const T* block_first, std::uint64_t elements) {
+  std::uintptr_t last = ~std::uintptr_t(0);
+  for (; elements != 0; elements &= elements - 1) {
+    const auto* element = reinterpret_cast<const char*>(block_first + std::countr_zero(elements));
+    const std::uintptr_t line = reinterpret_cast<std::uintptr_t>(element + sizeof(T) - 1) / 64;
+    if (line == last) continue;
+    __builtin_prefetch(element);
+    __builtin_prefetch(element + sizeof(T) - 1);
+    last = line;
+  }
+}
+
+// Bit i set where flags[i] (bytes of 0 or 1), for 8 flags.
+std::uint64_t flag_bits(const bool* flags) {
+  std::uint64_t word;
+  std::memcpy(&word, flags, sizeof(word));
+  return (word * 0x0102040810204080ull) >> 56;
+}
+
 Eigen::Vector3i floor_div(const Eigen::Vector3i& v, int side) {
   return {v.x() >= 0 ? v.x() / side : -((-v.x() + side - 1) / side),
           v.y() >= 0 ? v.y() / side : -((-v.y() + side - 1) / side),
@@ -97,29 +118,6 @@ void ObservationGrid::prefetch_surface_flags(int block) const {
   prefetch_lines(next_refresh_frame_.get() + first, voxels_per_block_ * sizeof(int));
   prefetch_lines(has_surface_.get() + first, voxels_per_block_ * sizeof(bool));
 }
-
-namespace {
-// Prefetches the lines holding elements i of `block_first` whose bit i is set in `elements`.
-template <class T>
-void prefetch_selected(const T* block_first, std::uint64_t elements) {
-  std::uintptr_t last = ~std::uintptr_t(0);
-  for (; elements != 0; elements &= elements - 1) {
-    const auto* element = reinterpret_cast<const char*>(block_first + std::countr_zero(elements));
-    const std::uintptr_t line = reinterpret_cast<std::uintptr_t>(element + sizeof(T) - 1) / 64;
-    if (line == last) continue;
-    __builtin_prefetch(element);
-    __builtin_prefetch(element + sizeof(T) - 1);
-    last = line;
-  }
-}
-
-// Bit i set where flags[i] (bytes of 0 or 1), for 8 flags.
-std::uint64_t flag_bits(const bool* flags) {
-  std::uint64_t word;
-  std::memcpy(&word, flags, sizeof(word));
-  return (word * 0x0102040810204080ull) >> 56;
-}
-}  // namespace
 
 void ObservationGrid::prefetch_voxel_state(int block) const {
   const std::size_t first = std::size_t(block) * voxels_per_block_;
@@ -400,7 +398,7 @@ void ObservationGrid::prefetch_refit_state(const NeighbourBlocks& around) const 
     if (around[std::size_t(i)] < 0) continue;
     const std::size_t first = std::size_t(around[std::size_t(i)]) * voxels;
     prefetch_lines(has_surface_.get() + first, voxels * sizeof(bool));
-    if (i != 13) continue;  // the block itself: the refit reads all of its voxels' state
+    if (i != kOwnBlock) continue;  // the refit reads all of its own voxels' state
     prefetch_lines(next_refresh_frame_.get() + first, voxels * sizeof(int));
     prefetch_lines(surface_settled_.get() + first, voxels * sizeof(std::uint8_t));
     prefetch_lines(position_.get() + first, voxels * sizeof(Eigen::Vector3f));

@@ -195,6 +195,7 @@ class ObservationGrid {
   // Pool indices (-1: none) of the 3^3 blocks around a block, neighbour_offset(i) from it.
   using NeighbourBlocks = std::array<int, 27>;
   static Eigen::Vector3i neighbour_offset(int i) { return {i % 3 - 1, (i / 3) % 3 - 1, i / 9 - 1}; }
+  static constexpr int kOwnBlock = 13;  // neighbour_offset(13) is zero
   // Replaces the gradient normals of the voxels of frame_blocks_[slot] refreshed in `frame` by
   // the plane through their neighbours' surface points (ObservationGridParams); `around` are
   // the blocks around it (find_neighbours). Before it, in this order, some blocks ahead:
