@@ -106,10 +106,23 @@ class TileDepthRanges {
 // the observed band in front of any surface is at least 4 voxels deep.
 constexpr int kUnobservedStride = 3;
 
-// Depth t (metres along the optical axis) of the first + to - crossing along origin + t * ray,
-// or 0 when there is none in [t_min, t_max]. ray has z = 1 in camera space.
-float march(TsdfSampler& sampler, const Eigen::Vector3f& origin, const Eigen::Vector3f& ray,
-            float t_min, float t_max, float voxel, float block) {
+// How far in front of a hinted depth (voxels) a ray starts first: the model's surface lies
+// within depth noise of the depth just fused, and from there two trilinear samples usually
+// bracket it, where the band's front edge took one or two nearest-voxel steps more.
+constexpr float kHintLead = 2;
+
+// Where a march ended: the depth t (metres along the optical axis) of the first + to - crossing,
+// or 0 when there is none; back_face when it entered a surface from behind (a negative observed
+// sample with no positive one just before it).
+struct MarchEnd {
+  float t = 0;
+  bool back_face = false;
+};
+
+// The first + to - crossing along origin + t * ray in [t_min, t_max]. ray has z = 1 in camera
+// space.
+MarchEnd march(TsdfSampler& sampler, const Eigen::Vector3f& origin, const Eigen::Vector3f& ray,
+               float t_min, float t_max, float voxel, float block) {
   const float inverse_length = 1.0f / ray.norm();
   const float voxel_step = voxel * inverse_length;
   float previous_t = 0, previous_sdf = 0;
@@ -146,15 +159,16 @@ float march(TsdfSampler& sampler, const Eigen::Vector3f& origin, const Eigen::Ve
       continue;
     }
     if (sdf < 0) {
-      if (!previous_observed) return 0;  // entered behind a surface: a back face
-      return previous_t + (t - previous_t) * previous_sdf / (previous_sdf - sdf);
+      // Entered behind a surface (a back face), or a crossing between two samples.
+      if (!previous_observed) return {.back_face = true};
+      return {.t = previous_t + (t - previous_t) * previous_sdf / (previous_sdf - sdf)};
     }
     previous_t = t;
     previous_sdf = sdf;
     previous_observed = true;
     t += std::max(voxel, 0.8f * sdf) * inverse_length;
   }
-  return 0;
+  return {};
 }
 
 // Whether the central differences of normals_from_points() at (x, y) straddle a depth edge:
@@ -173,7 +187,8 @@ bool at_depth_edge(const ImageF& depth, int x, int y) {
 }  // namespace
 
 SurfaceView raycast(const TsdfVolume& volume, const Intrinsics& intrinsics,
-                    const Pose& camera_to_world, RaycastNormals normals, const ImageF* depth_hint) {
+                    const Pose& camera_to_world, RaycastNormals normals, const ImageF* depth_hint,
+                    RaycastColour colour) {
   if (depth_hint && (depth_hint->width() != intrinsics.width ||
                      depth_hint->height() != intrinsics.height || depth_hint->channels() != 1))
     throw Error("ray cast", "depth hint",
@@ -181,8 +196,9 @@ SurfaceView raycast(const TsdfVolume& volume, const Intrinsics& intrinsics,
                             intrinsics.height, depth_hint->width(), depth_hint->height(),
                             depth_hint->channels()));
   const int width = intrinsics.width, height = intrinsics.height;
+  const bool with_colour = colour == RaycastColour::nearest_voxel;
   SurfaceView view{ImageF(width, height, 1), ImageF(width, height, 3, kNaN), ImageF(),
-                   ImageF(width, height, 3)};
+                   with_colour ? ImageF(width, height, 3) : ImageF()};
   const Eigen::Matrix3f rotation = camera_to_world.linear().cast<float>();
   const Eigen::Vector3f origin = camera_to_world.translation().cast<float>();
   const VolumeParams& params = volume.params();
@@ -197,20 +213,28 @@ SurfaceView raycast(const TsdfVolume& volume, const Intrinsics& intrinsics,
       ranges.interval(x, y, near, far);
       if (near > far) continue;
       const Eigen::Vector3f ray = rotation * intrinsics.ray(x, y).cast<float>();
-      // With a hint d, first from the truncation band's front edge d - t(d): in front of the
-      // surface the frame just fused, inside the space its voxels cover.
+      // With a hint d, first from kHintLead voxels in front of d, where the surface the frame
+      // just fused lies; where that start is already behind the model's surface, from the
+      // truncation band's front edge d - t(d), in front of the surface inside the space the
+      // frame's voxels cover.
       const float hint = depth_hint ? depth_hint->at(x, y, 0) : 0.0f;
-      const float start = hint - float(params.truncation_at(hint));
-      float t =
-          hint > 0 && start > near ? march(sampler, origin, ray, start, far, voxel, block) : 0;
-      if (!(t > 0)) t = march(sampler, origin, ray, near, far, voxel, block);
+      const float band_start = hint - float(params.truncation_at(hint));
+      float t = 0;
+      if (hint > 0 && band_start > near) {
+        const float lead_start = std::max(band_start, hint - kHintLead * voxel);
+        MarchEnd end = march(sampler, origin, ray, lead_start, far, voxel, block);
+        if (end.back_face && lead_start > band_start)
+          end = march(sampler, origin, ray, band_start, far, voxel, block);
+        t = end.t;
+      }
+      if (!(t > 0)) t = march(sampler, origin, ray, near, far, voxel, block).t;
       if (t <= 0) continue;
       const Eigen::Vector3f p = origin + ray * t;
       view.depth_m.at(x, y, 0) = t;
-      const Eigen::Vector3f colour = sampler.nearest_colour(p);
-      for (int c = 0; c < 3; ++c) {
-        view.points_m.at(x, y, c) = p[c];
-        view.colour.at(x, y, c) = colour[c];
+      for (int c = 0; c < 3; ++c) view.points_m.at(x, y, c) = p[c];
+      if (with_colour) {
+        const Eigen::Vector3f rgb = sampler.nearest_colour(p);
+        for (int c = 0; c < 3; ++c) view.colour.at(x, y, c) = rgb[c];
       }
     }
   });

@@ -18,7 +18,7 @@ struct SurfaceView {
   ImageF depth_m;   // 1 channel, z along the optical axis, 0 = no hit
   ImageF points_m;  // 3 channels, world coordinates, NaN = no hit
   ImageF normals;   // 3 channels, world, unit, towards the camera; NaN = none
-  ImageF colour;    // 3 channels, linear RGB of the nearest voxel, 0 = no hit
+  ImageF colour;    // 3 channels, linear RGB of the nearest voxel, 0 = no hit; empty unless asked
 };
 
 // Where a view's normals come from. from_points: the cross product of the neighbouring pixels'
@@ -27,15 +27,20 @@ struct SurfaceView {
 // product is no normal of either: there the TSDF's gradient at the hit (renderings use this).
 enum class RaycastNormals { from_points, from_gradient };
 
+// Whether a view reads the colour of the voxel at each hit (of a volume that keeps colour): a
+// tenth of a tracking ray cast's time, which no tracking needs.
+enum class RaycastColour { none, nearest_voxel };
+
 // `depth_hint`, when given, is the depth image (same size; 0 = none) of the frame just fused from
-// this very pose: a ray whose pixel has depth d marches from d - truncation_at(d) first (the
-// band's front edge, free space in front of the surface the frame fused) and from its tile's
-// start only where that finds no surface. A surface in front of that start which the frame saw
+// this very pose: a ray whose pixel has depth d marches from two voxels in front of d first;
+// where that start lies behind a surface (depth noise), from d - truncation_at(d) (the band's
+// front edge, free space in front of the surface the frame fused); and from its tile's start
+// only where neither finds a surface. A surface in front of the band's edge which the frame saw
 // through (a stale one) is then not found. Throws glint::Error when its size differs from the
 // view's.
 SurfaceView raycast(const TsdfVolume& volume, const Intrinsics& intrinsics,
                     const Pose& camera_to_world,
                     RaycastNormals normals = RaycastNormals::from_points,
-                    const ImageF* depth_hint = nullptr);
+                    const ImageF* depth_hint = nullptr, RaycastColour colour = RaycastColour::none);
 
 }  // namespace glint::fusion

@@ -38,7 +38,8 @@ TEST(Raycast, SphereDepthAndNormalsMatchTheAnalyticSurface) {
   const Intrinsics& camera = kCamera;
   const Eigen::Vector3d& centre = kCentre;
   const double radius = kRadius;
-  const SurfaceView view = raycast(*volume, camera, Pose::Identity());
+  const SurfaceView view = raycast(*volume, camera, Pose::Identity(), RaycastNormals::from_points,
+                                   nullptr, RaycastColour::nearest_voxel);
   int hits = 0;
   for (int y = 1; y < camera.height - 1; ++y) {
     for (int x = 1; x < camera.width - 1; ++x) {
@@ -62,7 +63,8 @@ TEST(Raycast, SphereDepthAndNormalsMatchTheAnalyticSurface) {
     }
   }
   EXPECT_GT(hits, 200);
-  EXPECT_EQ(view.depth_m.at(0, 0, 0), 0.0f);  // the corner ray misses
+  EXPECT_EQ(view.depth_m.at(0, 0, 0), 0.0f);                               // the corner ray misses
+  EXPECT_TRUE(raycast(*volume, camera, Pose::Identity()).colour.empty());  // unless asked
 }
 
 // First intersection depth of pixel (x, y)'s ray with the sphere, or 0 where it misses or grazes.
@@ -116,6 +118,13 @@ TEST(Raycast, ADepthHintBehindASurfaceFindsTheHintedOne) {
       raycast(*volume, kCamera, Pose::Identity(), RaycastNormals::from_points, &hint);
   EXPECT_NEAR(view.depth_m.at(x, y, 0), kWall, 0.002);
   EXPECT_NEAR(view.depth_m.at(x + 1, y, 0), sphere_depth(x + 1, y), 0.002);  // no hint there
+  // A hint 2.5 voxels behind the wall (depth noise): the first start, two voxels in front of
+  // it, lies behind the wall; the band's front edge is in front of it, and the wall is found,
+  // not the sphere.
+  hint.at(x, y, 0) = float(kWall + 0.025);
+  EXPECT_NEAR(raycast(*volume, kCamera, Pose::Identity(), RaycastNormals::from_points, &hint)
+                  .depth_m.at(x, y, 0),
+              kWall, 0.002);
   const ImageF wrong(kCamera.width / 2, kCamera.height, 1);
   EXPECT_THROW(raycast(*volume, kCamera, Pose::Identity(), RaycastNormals::from_points, &wrong),
                Error);
