@@ -3,7 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
-#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -231,6 +231,27 @@ NormalEquations associate(const PyramidLevel& level, const SurfaceView& model,
       tbb::simple_partitioner());
 }
 
+// The least-squares twist of `equations` within the directions they constrain: along an
+// eigenvector of the normal matrix whose eigenvalue is under min_ratio times the largest (the
+// translation along a floor that is most of what the pairs see, at a pyramid's coarse levels) the
+// solution is noise over almost nothing, so the twist has no component there and the estimate
+// keeps the prediction. False where the system is empty or not finite.
+bool solve_constrained(const NormalEquations& equations, double min_ratio,
+                       Eigen::Matrix<double, 6, 1>& twist) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(
+      equations.lhs.selfadjointView<Eigen::Upper>());
+  if (eigen.info() != Eigen::Success) return false;
+  const Eigen::Matrix<double, 6, 1>& values = eigen.eigenvalues();  // ascending
+  if (!(values[5] > 0) || !std::isfinite(values[5])) return false;
+  twist.setZero();
+  for (int k = 0; k < 6; ++k) {
+    if (!(values[k] > min_ratio * values[5])) continue;
+    const auto direction = eigen.eigenvectors().col(k);
+    twist += direction * (direction.dot(equations.rhs) / values[k]);
+  }
+  return twist.allFinite();
+}
+
 // exp of a small twist (rotation vector, translation) as a rigid transform.
 Pose twist_to_pose(const Eigen::Matrix<double, 6, 1>& twist) {
   Pose update = Pose::Identity();
@@ -258,11 +279,8 @@ TrackingResult track_frame(const ImageF& depth_m, const Intrinsics& intrinsics,
       last = associate(levels[level], model, model_intrinsics, world_to_model_camera, estimate,
                        params);
       if (last.count < 6) break;
-      const Eigen::Matrix<double, 6, 6> lhs = last.lhs.selfadjointView<Eigen::Upper>();
-      const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(lhs);
-      if (solver.info() != Eigen::Success) break;
-      const Eigen::Matrix<double, 6, 1> twist = solver.solve(last.rhs);
-      if (!twist.allFinite()) break;
+      Eigen::Matrix<double, 6, 1> twist;
+      if (!solve_constrained(last, params.min_constraint_ratio, twist)) break;
       estimate = twist_to_pose(twist) * estimate;
       if (twist.norm() < 1e-6) break;
     }

@@ -22,9 +22,13 @@ struct TrackingParams {
   double max_distance_m = 0.10;
   double max_normal_angle_deg = 30;
   BilateralParams bilateral;
-  // A solution with fewer inlier pairs than this fraction of the finest level's pixels, or an
-  // ill-conditioned system, counts as lost.
+  // A solution with fewer inlier pairs than this fraction of the finest level's pixels counts as
+  // lost.
   double min_inlier_fraction = 0.05;
+  // Directions of the pose (eigenvectors of the normal equations) whose eigenvalue is under this
+  // fraction of the largest are not updated: the pairs leave them free (a plane leaves the
+  // translations along it free), and a solution there is noise.
+  double min_constraint_ratio = 1e-5;
   // The model is ray cast at the frame's resolution halved this many times (FusionPipeline):
   // the frame's points associate with the nearest model pixel either way.
   int model_halvings = 0;

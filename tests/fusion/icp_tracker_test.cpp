@@ -94,6 +94,25 @@ TEST_F(IcpTracker, TheEstimateDoesNotDependOnTheNumberOfThreads) {
   EXPECT_TRUE(parallel.camera_to_world.matrix() == serial.camera_to_world.matrix());
 }
 
+// A wall seen alone constrains only the distance to it and the tilts towards it: the estimate
+// moves along its normal and keeps the prediction in the directions the wall leaves free (the
+// translations along it, the roll about its normal), where a solution would be noise.
+TEST_F(IcpTracker, DirectionsAWallLeavesFreeKeepThePrediction) {
+  TsdfVolume wall(params());
+  test::fill_analytic(
+      wall, [](const Eigen::Vector3d& p) { return 2.0 - p.z(); }, 2.2, 0.08);
+  const Pose reference = Pose::Identity();
+  const SurfaceView model = raycast(wall, camera_, reference);
+  const Pose moved = moved_pose(0, Eigen::Vector3d::UnitZ(), Eigen::Vector3d(0.02, 0, 0.03));
+  const TrackingResult result = track_frame(raycast(wall, camera_, moved).depth_m, camera_, model,
+                                            camera_, reference, reference);
+  ASSERT_EQ(result.status, TrackingStatus::tracked);
+  EXPECT_NEAR(result.camera_to_world.translation().z(), 0.03, 0.002);
+  EXPECT_NEAR(result.camera_to_world.translation().x(), 0, 1e-6);
+  EXPECT_NEAR(result.camera_to_world.translation().y(), 0, 1e-6);
+  EXPECT_LT(Eigen::AngleAxisd(result.camera_to_world.rotation()).angle(), 1e-3);
+}
+
 TEST_F(IcpTracker, EmptyFrameIsLostNotACrash) {
   const SurfaceView model = raycast(volume_, camera_, Pose::Identity());
   const TrackingResult result = track_frame(ImageF(80, 60, 1, 0.0f), camera_, model, camera_,
