@@ -59,8 +59,9 @@ reflectance::MaterialMaps render_model(const reflectance::ReflectancePipeline& p
                                        float normal_radius_m, StageTimings& timings,
                                        const ImageF* fused_depth = nullptr) {
   Stopwatch watch;
-  fusion::SurfaceView view = fusion::raycast(pipeline.geometry(), intrinsics, pose,
-                                             fusion::RaycastNormals::from_gradient, fused_depth);
+  fusion::SurfaceView view = fusion::raycast(
+      pipeline.geometry(), intrinsics, pose,
+      {.normals = fusion::RaycastNormals::from_gradient, .depth_hint = fused_depth});
   timings.add("raycast", watch.elapsed_ms());
   if (normal_radius_m > 0) {
     watch.restart();

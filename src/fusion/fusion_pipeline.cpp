@@ -66,12 +66,13 @@ FrameResult FusionPipeline::process(const io::RgbdFrame& frame) {
   }
   if (!params_.use_ground_truth_poses) {
     Stopwatch watch;
-    // The frame was just fused from this pose: its depth tells each ray where the surface is.
+    // The frame was just fused from this pose: its depth tells each ray where the surface is,
+    // and where it has none, no ray is cast.
     ImageF halved;
     const ImageF& hint = halved_depth(frame.depth_m, params_.tracking.model_halvings,
                                       params_.tracking.bilateral.sigma_depth_m, halved);
     model_ = raycast(volume_, model_intrinsics(), result.camera_to_world,
-                     RaycastNormals::from_points, &hint);
+                     {.depth_hint = &hint, .hinted_pixels_only = true});
     timings_.add("raycast", watch.elapsed_ms());
   }
   return result;

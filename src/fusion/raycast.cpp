@@ -201,17 +201,19 @@ class RayMarch {
 // neither finds it, from the tile's near depth.
 class PixelCast {
  public:
-  // Starts pixel (x, y); false when no allocated block projects there.
+  // Starts pixel (x, y); false when no allocated block projects there, or when only hinted
+  // pixels are cast and it has no hint.
   bool begin(int x, int y, const TileDepthRanges& ranges, const Intrinsics& intrinsics,
              const Eigen::Matrix3f& rotation, const VolumeParams& params,
-             const ImageF* depth_hint) {
+             const RaycastOptions& options) {
     ranges.interval(x, y, near_, far_);
     if (near_ > far_) return false;
+    const float hint = options.depth_hint ? options.depth_hint->at(x, y, 0) : 0.0f;
+    if (options.hinted_pixels_only && options.depth_hint && !(hint > 0)) return false;
     x_ = x;
     ray_ = rotation * intrinsics.ray(x, y).cast<float>();
     voxel_ = float(params.voxel_size_m);
     block_ = float(params.block_size_m());
-    const float hint = depth_hint ? depth_hint->at(x, y, 0) : 0.0f;
     band_start_ = hint - float(params.truncation_at(hint));
     if (hint > 0 && band_start_ > near_) {
       const float lead_start = std::max(band_start_, hint - kHintLead * voxel_);
@@ -263,7 +265,7 @@ constexpr int kRaysInFlight = 4;
 __attribute__((target_clones("arch=x86-64-v3", "default"), flatten)) void cast_row(
     int y, const TsdfVolume& volume, const BlockOccupancy& occupancy, const TileDepthRanges& ranges,
     const Intrinsics& intrinsics, const Eigen::Matrix3f& rotation, const Eigen::Vector3f& origin,
-    const ImageF* depth_hint, SurfaceView& view) {
+    const RaycastOptions& options, SurfaceView& view) {
   const int width = intrinsics.width;
   const bool with_colour = !view.colour.empty();
   std::array<PixelCast, kRaysInFlight> casts;
@@ -272,7 +274,7 @@ __attribute__((target_clones("arch=x86-64-v3", "default"), flatten)) void cast_r
   int next_x = 0, in_flight = 0;
   const auto start_next = [&](int lane) {
     while (next_x < width)
-      if (casts[lane].begin(next_x++, y, ranges, intrinsics, rotation, volume.params(), depth_hint))
+      if (casts[lane].begin(next_x++, y, ranges, intrinsics, rotation, volume.params(), options))
         return true;
     return false;
   };
@@ -312,28 +314,27 @@ bool at_depth_edge(const ImageF& depth, int x, int y) {
 }  // namespace
 
 SurfaceView raycast(const TsdfVolume& volume, const Intrinsics& intrinsics,
-                    const Pose& camera_to_world, RaycastNormals normals, const ImageF* depth_hint,
-                    RaycastColour colour) {
-  if (depth_hint && (depth_hint->width() != intrinsics.width ||
+                    const Pose& camera_to_world, const RaycastOptions& options) {
+  if (const ImageF* depth_hint = options.depth_hint;
+      depth_hint && (depth_hint->width() != intrinsics.width ||
                      depth_hint->height() != intrinsics.height || depth_hint->channels() != 1))
     throw Error("ray cast", "depth hint",
                 fmt::format("expected {}x{} with 1 channel, got {}x{}x{}", intrinsics.width,
                             intrinsics.height, depth_hint->width(), depth_hint->height(),
                             depth_hint->channels()));
   const int width = intrinsics.width, height = intrinsics.height;
-  const bool with_colour = colour == RaycastColour::nearest_voxel;
   SurfaceView view{ImageF(width, height, 1), ImageF(width, height, 3, kNaN), ImageF(),
-                   with_colour ? ImageF(width, height, 3) : ImageF()};
+                   options.colour ? ImageF(width, height, 3) : ImageF()};
   const Eigen::Matrix3f rotation = camera_to_world.linear().cast<float>();
   const Eigen::Vector3f origin = camera_to_world.translation().cast<float>();
   const TileDepthRanges ranges(volume, intrinsics, camera_to_world);
   const BlockOccupancy occupancy(volume);
   parallel_for(static_cast<std::size_t>(height), [&](std::size_t row) {
     cast_row(static_cast<int>(row), volume, occupancy, ranges, intrinsics, rotation, origin,
-             depth_hint, view);
+             options, view);
   });
   view.normals = normals_from_points(view.points_m, camera_to_world.translation());
-  if (normals == RaycastNormals::from_gradient)
+  if (options.normals == RaycastNormals::from_gradient)
     parallel_for(static_cast<std::size_t>(height), [&](std::size_t row) {
       TsdfSampler sampler(volume);
       const int y = static_cast<int>(row);

@@ -38,8 +38,7 @@ TEST(Raycast, SphereDepthAndNormalsMatchTheAnalyticSurface) {
   const Intrinsics& camera = kCamera;
   const Eigen::Vector3d& centre = kCentre;
   const double radius = kRadius;
-  const SurfaceView view = raycast(*volume, camera, Pose::Identity(), RaycastNormals::from_points,
-                                   nullptr, RaycastColour::nearest_voxel);
+  const SurfaceView view = raycast(*volume, camera, Pose::Identity(), {.colour = true});
   int hits = 0;
   for (int y = 1; y < camera.height - 1; ++y) {
     for (int x = 1; x < camera.width - 1; ++x) {
@@ -87,8 +86,7 @@ TEST(Raycast, ADepthHintFindsTheSurfaceNearIt) {
       float& d = hint.at(x, y, 0);
       d = (x + 3 * y) % 7 == 0 || !(d > 0) ? 0.0f : d + 0.005f * float((x + y) % 3 - 1);
     }
-  const SurfaceView hinted =
-      raycast(*volume, kCamera, Pose::Identity(), RaycastNormals::from_points, &hint);
+  const SurfaceView hinted = raycast(*volume, kCamera, Pose::Identity(), {.depth_hint = &hint});
   int hinted_hits = 0;
   for (int y = 0; y < kCamera.height; ++y)
     for (int x = 0; x < kCamera.width; ++x) {
@@ -102,6 +100,14 @@ TEST(Raycast, ADepthHintFindsTheSurfaceNearIt) {
       ++hinted_hits;
     }
   EXPECT_GT(hinted_hits, 150);
+  // Casting only the hinted pixels (the tracking model): the same depths there, none elsewhere.
+  const SurfaceView hinted_only = raycast(*volume, kCamera, Pose::Identity(),
+                                          {.depth_hint = &hint, .hinted_pixels_only = true});
+  for (int y = 0; y < kCamera.height; ++y)
+    for (int x = 0; x < kCamera.width; ++x)
+      EXPECT_EQ(hinted_only.depth_m.at(x, y, 0),
+                hint.at(x, y, 0) > 0 ? hinted.depth_m.at(x, y, 0) : 0.0f)
+          << x << "," << y;
 }
 
 // A hint behind a surface (one the frame saw through, e.g. an object since moved away): the ray
@@ -114,20 +120,18 @@ TEST(Raycast, ADepthHintBehindASurfaceFindsTheHintedOne) {
   const int x = kCamera.width / 2, y = kCamera.height / 2;
   ImageF hint(kCamera.width, kCamera.height, 1);
   hint.at(x, y, 0) = float(kWall);
-  const SurfaceView view =
-      raycast(*volume, kCamera, Pose::Identity(), RaycastNormals::from_points, &hint);
+  const SurfaceView view = raycast(*volume, kCamera, Pose::Identity(), {.depth_hint = &hint});
   EXPECT_NEAR(view.depth_m.at(x, y, 0), kWall, 0.002);
   EXPECT_NEAR(view.depth_m.at(x + 1, y, 0), sphere_depth(x + 1, y), 0.002);  // no hint there
   // A hint 2.5 voxels behind the wall (depth noise): the first start, two voxels in front of
   // it, lies behind the wall; the band's front edge is in front of it, and the wall is found,
   // not the sphere.
   hint.at(x, y, 0) = float(kWall + 0.025);
-  EXPECT_NEAR(raycast(*volume, kCamera, Pose::Identity(), RaycastNormals::from_points, &hint)
-                  .depth_m.at(x, y, 0),
-              kWall, 0.002);
+  EXPECT_NEAR(
+      raycast(*volume, kCamera, Pose::Identity(), {.depth_hint = &hint}).depth_m.at(x, y, 0), kWall,
+      0.002);
   const ImageF wrong(kCamera.width / 2, kCamera.height, 1);
-  EXPECT_THROW(raycast(*volume, kCamera, Pose::Identity(), RaycastNormals::from_points, &wrong),
-               Error);
+  EXPECT_THROW(raycast(*volume, kCamera, Pose::Identity(), {.depth_hint = &wrong}), Error);
 }
 
 TEST(Raycast, RaysCrossMetresOfEmptySpaceToAFarWall) {
@@ -179,7 +183,7 @@ TEST(Raycast, GradientNormalsHoldAtSilhouettes) {
   const Intrinsics& camera = kCamera;
   const SurfaceView points = raycast(*volume, camera, Pose::Identity());
   const SurfaceView gradient =
-      raycast(*volume, camera, Pose::Identity(), RaycastNormals::from_gradient);
+      raycast(*volume, camera, Pose::Identity(), {.normals = RaycastNormals::from_gradient});
   const auto normal = [](const SurfaceView& view, int x, int y) {
     return Eigen::Vector3d(view.normals.at(x, y, 0), view.normals.at(x, y, 1),
                            view.normals.at(x, y, 2));
