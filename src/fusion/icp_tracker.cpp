@@ -282,7 +282,7 @@ TrackingResult track_frame(const ImageF& depth_m, const Intrinsics& intrinsics,
       Eigen::Matrix<double, 6, 1> twist;
       if (!solve_constrained(last, params.min_constraint_ratio, twist)) break;
       estimate = twist_to_pose(twist) * estimate;
-      if (twist.norm() < 1e-6) break;
+      if (twist.norm() < params.converged_twist) break;
     }
   }
   last = associate(levels[0], model, model_intrinsics, world_to_model_camera, estimate, params);
