@@ -276,6 +276,27 @@ BlockKernel block_kernel() {
   return integrate_block_baseline;
 }
 
+// The running mean of the colours each voxel of a block was fused with (fused_pixel: the
+// voxel's pixel, or -1 where it was not fused; weight_before: its weight before this frame).
+// (restrict: the frame's planes and the block's colours never overlap.)
+void fuse_block_colours(const std::int32_t* fused_pixel, const float* weight_before,
+                        const std::array<const float*, 3>& frame,
+                        const std::array<float*, 3>& block) {
+  const float* __restrict red_in = frame[0];
+  const float* __restrict green_in = frame[1];
+  const float* __restrict blue_in = frame[2];
+  float* __restrict red = block[0];
+  float* __restrict green = block[1];
+  float* __restrict blue = block[2];
+  for (int v = 0; v < kVoxelsPerBlock; ++v) {
+    const int pixel = fused_pixel[v];
+    if (pixel < 0) continue;
+    red[v] = fuse_colour(red[v], weight_before[v], red_in[pixel]);
+    green[v] = fuse_colour(green[v], weight_before[v], green_in[pixel]);
+    blue[v] = fuse_colour(blue[v], weight_before[v], blue_in[pixel]);
+  }
+}
+
 }  // namespace
 
 FrameIntegration::FrameIntegration(const TsdfVolume& volume, const VisibleBlocks& visible,
@@ -340,16 +361,8 @@ void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const Im
     fuse_block(frame.constants(), origin.data(), sdf, weight, fused_pixel.data(),
                volume.sdf_m(next_block), volume.weight(next_block));
     if (!with_colour) return;
-    float* red = volume.red(block);
-    float* green = volume.green(block);
-    float* blue = volume.blue(block);
-    for (int v = 0; v < kVoxelsPerBlock; ++v) {
-      const int pixel = fused_pixel[v];
-      if (pixel < 0) continue;
-      red[v] = fuse_colour(red[v], weight_before[v], red_in[pixel]);
-      green[v] = fuse_colour(green[v], weight_before[v], green_in[pixel]);
-      blue[v] = fuse_colour(blue[v], weight_before[v], blue_in[pixel]);
-    }
+    fuse_block_colours(fused_pixel.data(), weight_before.data(), {red_in, green_in, blue_in},
+                       {volume.red(block), volume.green(block), volume.blue(block)});
   });
 }
 

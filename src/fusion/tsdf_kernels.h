@@ -27,9 +27,10 @@ GLINT_HOST_DEVICE inline void fuse_voxel(const T& measured_sdf_m, const T& trunc
 }
 
 // The same running average for a colour channel; `weight_before` is the voxel's weight before
-// fuse_voxel() updated it.
+// fuse_voxel() updated it. By the reciprocal, which the three channels of a voxel share where
+// they are inlined together: three divisions were a sixth of a colour frame's integration.
 GLINT_HOST_DEVICE inline float fuse_colour(float mean, float weight_before, float observation) {
-  return (mean * weight_before + observation) / (weight_before + 1.0f);
+  return (mean * weight_before + observation) * (1.0f / (weight_before + 1.0f));
 }
 
 // One frame's integration constants, in camera coordinates (plain data: the CUDA kernel gets a
