@@ -120,41 +120,45 @@ struct MarchEnd {
   bool back_face = false;
 };
 
-// The search for the first + to - crossing along origin + t * ray in [t_min, t_max] (ray has
-// z = 1 in camera space), one sample per step(): each sample's position depends on the one
-// before, so a ray is a chain of dependent loads, and a thread advances several rays in turn to
-// overlap their chains.
+// The search for the first + to - crossing along origin + t * ray up to t_max (ray has z = 1
+// in camera space), one sample per step(): each sample's position depends on the one before, so
+// a ray is a chain of dependent loads, and a thread advances several rays in turn to overlap
+// their chains. start() begins (or begins again) at a given t.
 class RayMarch {
  public:
   RayMarch() = default;
-  RayMarch(const Eigen::Vector3f& ray, float t_min, float t_max, float voxel, float block)
-      : t_(t_min),
-        t_max_(t_max),
-        fine_until_(t_min),
+  RayMarch(const Eigen::Vector3f& ray, float t_max, float voxel, float block)
+      : t_max_(t_max),
         voxel_(voxel),
         inverse_length_(1.0f / ray.norm()),
         voxel_step_(voxel * inverse_length_),
         block_step_(0.5f * block * inverse_length_) {}
 
+  void start(float t_min) {
+    state_ = State{};
+    state_.t = state_.fine_until = t_min;
+  }
+
   // Takes the next sample; false once the march has ended (end() says how).
   bool step(TsdfSampler& sampler, const Eigen::Vector3f& origin, const Eigen::Vector3f& ray) {
-    if (!(t_ <= t_max_)) return false;
-    const Eigen::Vector3f p = origin + ray * t_;
+    State& s = state_;
+    if (!(s.t <= t_max_)) return false;
+    const Eigen::Vector3f p = origin + ray * s.t;
     float sdf;
     TsdfSampler::Sample sample = sampler.nearest(p, sdf);
-    if (sample != TsdfSampler::Sample::unallocated && stride_start_ >= 0) {
+    if (sample != TsdfSampler::Sample::unallocated && s.stride_start >= 0) {
       if (sample == TsdfSampler::Sample::observed) {
-        fine_until_ = t_;
-        t_ = stride_start_ + voxel_step_;
-        stride_start_ = -1;
+        s.fine_until = s.t;
+        s.t = s.stride_start + voxel_step_;
+        s.stride_start = -1;
         return true;
       }
-      stride_start_ = -1;
+      s.stride_start = -1;
     }
-    if (sample == TsdfSampler::Sample::unobserved && t_ >= fine_until_) {
-      stride_start_ = t_;
-      t_ += kUnobservedStride * voxel_step_;
-      previous_observed_ = false;
+    if (sample == TsdfSampler::Sample::unobserved && s.t >= s.fine_until) {
+      s.stride_start = s.t;
+      s.t += kUnobservedStride * voxel_step_;
+      s.previous_observed = false;
       return true;
     }
     // Near the surface, the trilinear value (a voxel without all 8 neighbours observed counts
@@ -162,36 +166,41 @@ class RayMarch {
     if (sample == TsdfSampler::Sample::observed && sdf < 2 * voxel_ && !sampler.trilinear(p, sdf))
       sample = TsdfSampler::Sample::unobserved;
     if (sample != TsdfSampler::Sample::observed) {
-      previous_observed_ = false;
-      t_ += sample == TsdfSampler::Sample::unallocated ? block_step_ : voxel_step_;
+      s.previous_observed = false;
+      s.t += sample == TsdfSampler::Sample::unallocated ? block_step_ : voxel_step_;
       return true;
     }
     if (sdf < 0) {
       // Entered behind a surface (a back face), or a crossing between two samples.
-      end_ = previous_observed_ ? MarchEnd{.t = previous_t_ + (t_ - previous_t_) * previous_sdf_ /
-                                                                  (previous_sdf_ - sdf)}
-                                : MarchEnd{.back_face = true};
-      t_max_ = -1;  // ended
+      s.end = s.previous_observed
+                  ? MarchEnd{.t = s.previous_t +
+                                  (s.t - s.previous_t) * s.previous_sdf / (s.previous_sdf - sdf)}
+                  : MarchEnd{.back_face = true};
+      s.t = std::numeric_limits<float>::infinity();  // ended
       return false;
     }
-    previous_t_ = t_;
-    previous_sdf_ = sdf;
-    previous_observed_ = true;
-    t_ += std::max(voxel_, 0.8f * sdf) * inverse_length_;
+    s.previous_t = s.t;
+    s.previous_sdf = sdf;
+    s.previous_observed = true;
+    s.t += std::max(voxel_, 0.8f * sdf) * inverse_length_;
     return true;
   }
 
-  const MarchEnd& end() const { return end_; }
+  const MarchEnd& end() const { return state_.end; }
 
  private:
-  float t_ = 0, t_max_ = -1;
-  float previous_t_ = 0, previous_sdf_ = 0;
-  bool previous_observed_ = false;
-  // The start of the last stride through unobserved voxels, and where voxel steps end again
-  // after stepping back over it.
-  float stride_start_ = -1, fine_until_ = 0;
+  struct State {
+    float t = 0;
+    // The start of the last stride through unobserved voxels (-1: none), and where voxel steps
+    // end again after stepping back over it.
+    float stride_start = -1, fine_until = 0;
+    float previous_t = 0, previous_sdf = 0;
+    bool previous_observed = false;
+    MarchEnd end;
+  };
+  float t_max_ = -1;
   float voxel_ = 0, inverse_length_ = 0, voxel_step_ = 0, block_step_ = 0;
-  MarchEnd end_;
+  State state_;
 };
 
 // One pixel's ray and its marches in turn until one finds the surface. With a hint d (the depth
@@ -206,21 +215,22 @@ class PixelCast {
   bool begin(int x, int y, const TileDepthRanges& ranges, const Intrinsics& intrinsics,
              const Eigen::Matrix3f& rotation, const VolumeParams& params,
              const RaycastOptions& options) {
-    ranges.interval(x, y, near_, far_);
-    if (near_ > far_) return false;
+    float far;
+    ranges.interval(x, y, near_, far);
+    if (near_ > far) return false;
     const float hint = options.depth_hint ? options.depth_hint->at(x, y, 0) : 0.0f;
     if (options.hinted_pixels_only && options.depth_hint && !(hint > 0)) return false;
     x_ = x;
     ray_ = rotation * intrinsics.ray(x, y).cast<float>();
-    voxel_ = float(params.voxel_size_m);
-    block_ = float(params.block_size_m());
+    const float voxel = float(params.voxel_size_m);
+    march_ = RayMarch(ray_, far, voxel, float(params.block_size_m()));
     band_start_ = hint - float(params.truncation_at(hint));
     if (hint > 0 && band_start_ > near_) {
-      const float lead_start = std::max(band_start_, hint - kHintLead * voxel_);
-      march_ = RayMarch(ray_, lead_start, far_, voxel_, block_);
+      const float lead_start = std::max(band_start_, hint - kHintLead * voxel);
+      march_.start(lead_start);
       phase_ = lead_start > band_start_ ? Phase::lead : Phase::band;
     } else {
-      march_ = RayMarch(ray_, near_, far_, voxel_, block_);
+      march_.start(near_);
       phase_ = Phase::tile;
     }
     return true;
@@ -232,10 +242,10 @@ class PixelCast {
     const MarchEnd& end = march_.end();
     if (end.t > 0 || phase_ == Phase::tile) return false;
     if (phase_ == Phase::lead && end.back_face) {
-      march_ = RayMarch(ray_, band_start_, far_, voxel_, block_);
+      march_.start(band_start_);
       phase_ = Phase::band;
     } else {
-      march_ = RayMarch(ray_, near_, far_, voxel_, block_);
+      march_.start(near_);
       phase_ = Phase::tile;
     }
     return true;
@@ -249,7 +259,7 @@ class PixelCast {
   enum class Phase { lead, band, tile };
   int x_ = 0;
   Eigen::Vector3f ray_;
-  float near_ = 0, far_ = 0, band_start_ = 0, voxel_ = 0, block_ = 0;
+  float near_ = 0, band_start_ = 0;
   Phase phase_ = Phase::tile;
   RayMarch march_;
 };
