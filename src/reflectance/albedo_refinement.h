@@ -7,6 +7,7 @@
 // per-channel median. L_l = intensity_l / r_l^2 (near-field point lights); shadowing is
 // ignored, as in the paper.
 #include <Eigen/Core>
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,7 +31,17 @@ struct RefinedAlbedo {
   // and a normal tilted by d changes that by about t d: under grazing light (cosine 0.2, t ~ 5)
   // a 2-degree tilt is a 17 % error in kd.
   float light_cosine = 0.0f;
+  float light_tangent = 0.0f;  // t above, the same angle's tangent
 };
+
+// The weight of a voxel's refined albedo among its neighbours' (reflectance/material_maps.h):
+// the inverse of its variance under a normal error d, (t d)^2, with t the light's effective
+// incidence tangent, relative to light at 45 degrees or steeper (t <= 1, weight 1), where the
+// normal no longer dominates the error. Eq. (7) under grazing light then counts less than its
+// better-lit neighbours instead of the same: at cosine 0.3 a tenth.
+inline float refined_albedo_weight(float light_tangent) {
+  return 1.0f / std::max(1.0f, light_tangent * light_tangent);
+}
 
 // Eq. (7) over the voxel's observations (those seen from above the surface, at most
 // kMaxObservationsPerVoxel), combined by `average`; nullopt when there is none or no light

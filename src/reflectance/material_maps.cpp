@@ -6,6 +6,7 @@
 
 #include "core/fast_exp.h"
 #include "core/parallel.h"
+#include "reflectance/albedo_refinement.h"
 #include "render/ward.h"
 
 namespace glint::reflectance {
@@ -111,6 +112,7 @@ void select_segment(const ObservationGrid& grid, int segment, RefinedNeighbourho
     if (v < 0 || !grid.refined_kd_reliable(v)) continue;
     const Eigen::Vector3f& kd = grid.refined_kd(v);
     const std::size_t k = std::size_t(around.reliable++);
+    around.weight[k] = refined_albedo_weight(grid.refined_kd_light_tangent(v));
     around.red[k] = kd.x();
     around.green[k] = kd.y();
     around.blue[k] = kd.z();
@@ -153,8 +155,8 @@ void smooth_refined_kd(const RefinedNeighbourhood& around, const Eigen::Vector3f
     const float r = (std::fabs(around.red[k] - red) + std::fabs(around.green[k] - green) +
                      std::fabs(around.blue[k] - blue)) *
                     inverse_scale;
-    weight[k] =
-        wide_tent(t, around.dx[k], around.dy[k], around.dz[k]) * exp_nonpositive(-0.5f * r * r);
+    weight[k] = around.weight[k] * wide_tent(t, around.dx[k], around.dy[k], around.dz[k]) *
+                exp_nonpositive(-0.5f * r * r);
   }
   Eigen::Vector3f sum = Eigen::Vector3f::Zero();
   float weights = 0;
@@ -175,12 +177,16 @@ bool interpolate(const ObservationGrid& grid, const RefinedNeighbourhood& around
     if (v < 0) continue;
     const float weight = ((c & 1) ? t.x() : 1 - t.x()) * (((c >> 1) & 1) ? t.y() : 1 - t.y()) *
                          (((c >> 2) & 1) ? t.z() : 1 - t.z());
-    (grid.refined_kd_reliable(v) ? reliable : unreliable).add(weight, grid.refined_kd(v));
+    if (grid.refined_kd_reliable(v))
+      reliable.add(weight * refined_albedo_weight(grid.refined_kd_light_tangent(v)),
+                   grid.refined_kd(v));
+    else
+      unreliable.add(weight, grid.refined_kd(v));
   }
   if (reliable.count == 0) {
     // No corner is reliable: the reliable voxels one further out, under a tent twice as wide.
     for (int k = 0; k < around.reliable; ++k)
-      reliable.add(wide_tent(t, around.dx[k], around.dy[k], around.dz[k]),
+      reliable.add(around.weight[k] * wide_tent(t, around.dx[k], around.dy[k], around.dz[k]),
                    {around.red[k], around.green[k], around.blue[k]});
   }
   if (reliable.count == 0 && !unreliable_corners) return false;

@@ -48,7 +48,9 @@ WardShading ward_shading(float alpha, const Eigen::Vector3f& p, const Eigen::Vec
 // that is not grazing, ObservationGrid::refined_kd_reliable) where there are any; with none
 // reliable, the reliable voxels of the 4^3 around p under a tent of twice the width, and only
 // without those the unreliable corners (when `unreliable_corners`: a caller with a better
-// albedo for p, such as the segment's refined one, keeps its own). Less a minority of outliers
+// albedo for p, such as the segment's refined one, keeps its own). The reliable voxels'
+// weights are multiplied by refined_albedo_weight(), less the more grazing their light was
+// (reflectance/albedo_refinement.h), here and in the smoothing below. Less a minority of outliers
 // (at most a quarter of four or more, mean albedo off their median by more than
 // kRefinedKdOutlier of it), renormalised; false when there is none.
 // With `smoothing` > 0 that estimate is then smoothed edge-preservingly: the reliable voxels of
@@ -70,9 +72,9 @@ struct RefinedNeighbourhood {
   int segment = -1;
   std::array<int, 64> voxels{};
   // Those with a reliable refined albedo, as arrays for the smoothing's vectorised loop: the
-  // albedo and the offset from the cell's first corner.
+  // albedo, the offset from the cell's first corner and the voxel's refined_albedo_weight().
   int reliable = 0;
-  std::array<float, 64> red, green, blue, dx, dy, dz;
+  std::array<float, 64> red, green, blue, dx, dy, dz, weight;
 };
 
 struct PointMaterial {

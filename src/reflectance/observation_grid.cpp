@@ -229,6 +229,7 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
   segment_confidence_ = voxel_pool<std::int16_t>(voxels);
   has_refined_kd_ = voxel_pool<bool>(voxels);
   refined_kd_reliable_ = voxel_pool<bool>(voxels);
+  refined_kd_light_tangent_ = voxel_pool<float>(voxels);
   block_last_frame_ = std::make_unique<std::atomic<int>[]>(hash_.capacity());
   for (std::size_t i = 0; i < hash_.capacity(); ++i) block_last_frame_[i] = -1;
 }

@@ -49,7 +49,7 @@ struct ObservationGridParams {
   int observations_per_voxel = 30;  // m
   // Pool size; exhaustion is a glint::Error. 0: 2^20 voxels at 2 cm and above, and
   // 2 (0.02 / voxel_size_m)^2 times that below (a surface holds (0.02 / v)^2 times as many
-  // voxels, and finer grids leave more of each block empty). About 60 bytes per voxel and
+  // voxels, and finer grids leave more of each block empty). About 75 bytes per voxel and
   // 630 bytes of observation slots per voxel that has been observed, committed as they are used.
   std::size_t voxel_capacity = 0;
   int allocation_stride_px = 2;       // every n-th pixel of every n-th row allocates
@@ -143,6 +143,10 @@ class ObservationGrid {
   // (RefinedAlbedo::light_cosine, ReflectanceParams::albedo_min_light_cosine).
   bool& refined_kd_reliable(int v) { return refined_kd_reliable_[v]; }
   bool refined_kd_reliable(int v) const { return refined_kd_reliable_[v]; }
+  // The tangent of that light's effective incidence angle (RefinedAlbedo::light_tangent; 0 until
+  // set), which weighs the voxel among its neighbours (refined_albedo_weight).
+  float& refined_kd_light_tangent(int v) { return refined_kd_light_tangent_[v]; }
+  float refined_kd_light_tangent(int v) const { return refined_kd_light_tangent_[v]; }
 
   // Look-ups of many nearby voxels (a rendering's pixels, a mesh's vertices) may keep the
   // blocks they found in a cache of their own (one per thread), which spares most hash look-ups.
@@ -259,6 +263,7 @@ class ObservationGrid {
   PoolArray<std::int32_t> segment_;
   PoolArray<std::int16_t> segment_confidence_;
   PoolArray<bool> has_refined_kd_, refined_kd_reliable_;
+  PoolArray<float> refined_kd_light_tangent_;
 
   std::vector<VisibleVoxel> visible_;
   // collect()'s scratch: per frame block, voxels_per_block_ entries of which the first

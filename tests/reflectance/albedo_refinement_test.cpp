@@ -120,8 +120,13 @@ TEST(AlbedoRefinement, LightCosineIsTheEffectiveIncidenceOfTheLights) {
   const Observation o(Eigen::Vector3f::Constant(0.5f), Eigen::Vector3f::UnitY(), 0);
   const Eigen::Vector3f normal = Eigen::Vector3f::UnitY();
   const auto light_cosine = [&](const std::vector<render::PointLight>& lights) {
-    return refine_albedo(&o, 1, Eigen::Vector3f::Zero(), normal, lights, {0, 0, 0}, 0.1f)
-        ->light_cosine;
+    const RefinedAlbedo refined =
+        *refine_albedo(&o, 1, Eigen::Vector3f::Zero(), normal, lights, {0, 0, 0}, 0.1f);
+    // The tangent of the same angle.
+    EXPECT_NEAR(refined.light_tangent,
+                std::sqrt(1 - refined.light_cosine * refined.light_cosine) / refined.light_cosine,
+                1e-4f);
+    return refined.light_cosine;
   };
   // One light at 60 degrees from the normal: cos 60.
   std::vector<render::PointLight> lights(1);
@@ -140,6 +145,17 @@ TEST(AlbedoRefinement, LightCosineIsTheEffectiveIncidenceOfTheLights) {
   // A grazing light alone.
   lights.erase(lights.begin());
   EXPECT_NEAR(light_cosine(lights), std::cos(theta), 1e-5);
+}
+
+TEST(AlbedoRefinement, GrazingLightWeighsAnAlbedoByTheInverseOfItsVariance) {
+  // Light at 45 degrees or steeper: full weight.
+  EXPECT_EQ(refined_albedo_weight(0.0f), 1.0f);
+  EXPECT_EQ(refined_albedo_weight(1.0f), 1.0f);
+  // Beyond, the albedo's error under a normal error grows with the tangent, its variance with
+  // its square: cosine 0.3 (tangent 3.18) weighs about a tenth.
+  const float tangent = std::sqrt(1 - 0.3f * 0.3f) / 0.3f;
+  EXPECT_NEAR(refined_albedo_weight(tangent), 0.09f / 0.91f, 1e-6f);
+  EXPECT_NEAR(refined_albedo_weight(3.0f), 1.0f / 9, 1e-7f);
 }
 
 TEST(AlbedoRefinement, UnlitOrUnseenVoxelsHaveNoEstimate) {

@@ -129,6 +129,32 @@ TEST(MaterialMaps, UnreliableAlbedosGiveWayToTheReliableOnesAround) {
   EXPECT_NEAR(kd.x(), 0.95f, 1e-6f);
 }
 
+TEST(MaterialMaps, AlbedosSolvedUnderMoreGrazingLightWeighLess) {
+  Wall wall;
+  ASSERT_GT(wall.voxels(), 20u);
+  // A texture edge through p's cell: half its corners 0.3, half 0.9, all reliable.
+  const Eigen::Vector3f p(0.013f, -0.007f, 1.005f);
+  ObservationGrid& grid = wall.with_albedo([&](const Eigen::Vector3f& q) {
+    return Eigen::Vector3f::Constant(q.x() < p.x() ? 0.3f : 0.9f);
+  });
+  Eigen::Vector3f even, kd;
+  ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, even));
+  // The bright half solved under light at cosine 0.3 (tangent 3.18, weight 0.099): the dark
+  // half's trilinear weights a and the bright half's 1 - a become a and 0.099 (1 - a).
+  for (const VisibleVoxel& seen : wall.visible())
+    if (grid.position(seen.voxel).x() >= p.x())
+      grid.refined_kd_light_tangent(seen.voxel) = std::sqrt(1 - 0.09f) / 0.3f;
+  ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, kd));
+  const float dark = (0.9f - even.x()) / 0.6f;  // a
+  const float weight = 0.09f / 0.91f;
+  EXPECT_NEAR(kd.x(), (0.3f * dark + 0.9f * weight * (1 - dark)) / (dark + weight * (1 - dark)),
+              1e-5f);
+  EXPECT_LT(kd.x(), even.x() - 0.05f);
+  // The smoothing weighs them alike (the same edge, no range limit).
+  ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, kd, true, 1e6f));
+  EXPECT_LT(kd.x(), 0.3f + 0.6f * 0.25f);
+}
+
 TEST(MaterialMaps, RefinedAlbedoInterpolatesWithinTheSegmentOnly) {
   Wall wall;
   ASSERT_GT(wall.voxels(), 20u);
