@@ -72,7 +72,7 @@ reflectance::MaterialMaps render_model(const reflectance::ReflectancePipeline& p
   watch.restart();
   reflectance::MaterialMaps maps = reflectance::render_material_maps(
       view, pose, pipeline.observations(), pipeline.materials(), pipeline.lights(),
-      pipeline.exposure(), pipeline.albedo_smoothing());
+      pipeline.exposure(), pipeline.albedo_blend());
   timings.add("shade", watch.elapsed_ms());
   return maps;
 }
@@ -420,8 +420,10 @@ void register_reconstruct_command(CLI::App& app) {
       ->add_option("--albedo-min-cosine", params.albedo_min_light_cosine,
                    "Trust a voxel's refined albedo only where its light's effective incidence "
                    "cosine reaches this (grazing light makes eq. 7 ill-conditioned); elsewhere "
-                   "the re-renderings and the mesh use the reliable voxels around it (0 = trust "
-                   "all, as the paper)")
+                   "the re-renderings and the mesh use the reliable voxels around it; those "
+                   "blend in the segment's refined albedo as one more voxel lit at this cosine, "
+                   "and weigh each voxel by its light (0 = trust all and no segment albedo, as "
+                   "the paper)")
       ->check(CLI::Range(0.0f, 1.0f))
       ->capture_default_str();
   command

@@ -56,7 +56,7 @@ void write_material_mesh(const std::string& path,
   // lookup mostly finds its neighbourhood kept from the vertex before.
   parallel_for_chunks(n, 1024, [&](std::size_t begin, std::size_t end) {
     reflectance::MaterialLookup lookup(pipeline.observations(), pipeline.materials(),
-                                       pipeline.albedo_smoothing());
+                                       pipeline.albedo_blend());
     for (std::size_t i = begin; i < end; ++i) {
       reflectance::PointMaterial material;
       const bool with_material = lookup(mesh.vertices[i], material);

@@ -8,6 +8,7 @@
 // ignored, as in the paper.
 #include <Eigen/Core>
 #include <algorithm>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -42,6 +43,8 @@ struct RefinedAlbedo {
 inline float refined_albedo_weight(float light_tangent) {
   return 1.0f / std::max(1.0f, light_tangent * light_tangent);
 }
+// The tangent of the angle whose cosine is `cosine` in [0, 1] (infinite at 0).
+inline float tangent_of(float cosine) { return std::sqrt(1 - cosine * cosine) / cosine; }
 
 // Eq. (7) over the voxel's observations (those seen from above the surface, at most
 // kMaxObservationsPerVoxel), combined by `average`; nullopt when there is none or no light

@@ -137,14 +137,15 @@ float wide_tent(const Eigen::Vector3f& t, float dx, float dy, float dz) {
 // Joint bilateral smoothing (Tomasi and Manduchi 1998) of the albedo kd interpolated at the point
 // at t: the reliable voxels of its 4^3 under the wide tent, each weighted further by
 // exp(-r^2 / 2), r = its mean absolute channel difference from kd over contrast * (mean of kd +
-// 0.01). The voxel-to-voxel scatter of eq. (7) averages out; a texture edge of more contrast is
-// kept. The weights come from one vectorised loop (AVX2 where the CPU has it): an exp per voxel
-// and pixel was most of a re-rendering's material lookups.
+// 0.01), and the `segment` albedo (none or one) likewise under its own weight. The voxel-to-voxel
+// scatter of eq. (7) averages out; a texture edge of more contrast is kept. The weights come from
+// one vectorised loop (AVX2 where the CPU has it): an exp per voxel and pixel was most of a
+// re-rendering's material lookups.
 #if defined(__x86_64__)
 __attribute__((target_clones("arch=x86-64-v3", "default")))
 #endif
 void smooth_refined_kd(const RefinedNeighbourhood& around, const Eigen::Vector3f& t,
-                       float contrast, Eigen::Vector3f& kd) {
+                       float contrast, const WeightedAlbedos& segment, Eigen::Vector3f& kd) {
   const float red = kd.x(), green = kd.y(), blue = kd.z();
   // Albedos lie in [0, 1], so r <= 3 * inverse_scale: capped at 1000, -r^2 / 2 stays within
   // exp_nonpositive()'s range (a contrast that small weighs every other albedo at e^-50 or less
@@ -164,13 +165,22 @@ void smooth_refined_kd(const RefinedNeighbourhood& around, const Eigen::Vector3f
     sum += weight[k] * Eigen::Vector3f(around.red[k], around.green[k], around.blue[k]);
     weights += weight[k];
   }
+  for (int k = 0; k < segment.count; ++k) {
+    const float r = (segment.albedo[k] - kd).cwiseAbs().sum() * inverse_scale;
+    const float w = segment.weight[k] * exp_nonpositive(-0.5f * r * r);
+    sum += w * segment.albedo[k];
+    weights += w;
+  }
   if (weights > 1e-6f) kd = sum / weights;
 }
 
 // interpolate_refined_kd() at the point at t in the cell of `around`.
 bool interpolate(const ObservationGrid& grid, const RefinedNeighbourhood& around,
                  const Eigen::Vector3f& t, Eigen::Vector3f& kd, bool unreliable_corners,
-                 float smoothing) {
+                 const AlbedoBlend& blend) {
+  // The caller's albedo as one more voxel (none, or one entry).
+  WeightedAlbedos segment;
+  if (!unreliable_corners && blend.segment_weight > 0) segment.add(blend.segment_weight, kd);
   WeightedAlbedos reliable, unreliable;
   for (int c = 0; c < 8; ++c) {
     const int v = voxel_at(around, c & 1, (c >> 1) & 1, (c >> 2) & 1);
@@ -190,20 +200,22 @@ bool interpolate(const ObservationGrid& grid, const RefinedNeighbourhood& around
                    {around.red[k], around.green[k], around.blue[k]});
   }
   if (reliable.count == 0 && !unreliable_corners) return false;
+  if (segment.count > 0) reliable.add(segment.weight[0], segment.albedo[0]);
   if (!blend_without_outliers(reliable.count > 0 ? reliable : unreliable, kd)) return false;
-  if (smoothing > 0) smooth_refined_kd(around, t, smoothing, kd);
+  if (blend.smoothing > 0) smooth_refined_kd(around, t, blend.smoothing, segment, kd);
   return true;
 }
 
 }  // namespace
 
 bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& p, int segment,
-                            Eigen::Vector3f& kd, bool unreliable_corners, float smoothing) {
+                            Eigen::Vector3f& kd, bool unreliable_corners,
+                            const AlbedoBlend& blend) {
   const Cell cell = cell_of(grid, p);
   RefinedNeighbourhood around;
   look_up(grid, cell.base, around);
   select_segment(grid, segment, around);
-  return interpolate(grid, around, cell.t, kd, unreliable_corners, smoothing);
+  return interpolate(grid, around, cell.t, kd, unreliable_corners, blend);
 }
 
 namespace {
@@ -280,7 +292,7 @@ bool MaterialLookup::operator()(const Eigen::Vector3f& p, PointMaterial& materia
   material.fused = material.refined = fused->ward;
   if (fused->kd_refined) material.refined.kd = *fused->kd_refined;
   select_segment(grid_, material.segment, around_);
-  interpolate(grid_, around_, cell.t, material.refined.kd, !fused->kd_refined, albedo_smoothing_);
+  interpolate(grid_, around_, cell.t, material.refined.kd, !fused->kd_refined, blend_);
   return true;
 }
 
@@ -295,7 +307,7 @@ void put(ImageF& image, int x, int y, const Eigen::Vector3f& value) {
 MaterialMaps render_material_maps(const fusion::SurfaceView& surface, const Pose& camera_to_world,
                                   const ObservationGrid& grid, const SpecularEstimator& materials,
                                   const std::vector<render::PointLight>& lights, float exposure,
-                                  float albedo_smoothing) {
+                                  const AlbedoBlend& blend) {
   const int width = surface.depth_m.width(), height = surface.depth_m.height();
   MaterialMaps maps;
   maps.kd = maps.kd_refined = maps.ks = maps.rgb = maps.rgb_refined = ImageF(width, height, 3);
@@ -304,7 +316,7 @@ MaterialMaps render_material_maps(const fusion::SurfaceView& surface, const Pose
   const Eigen::Vector3f eye = camera_to_world.translation().cast<float>();
   parallel_for(std::size_t(height), [&](std::size_t row) {
     const int y = int(row);
-    MaterialLookup lookup(grid, materials, albedo_smoothing);
+    MaterialLookup lookup(grid, materials, blend);
     for (int x = 0; x < width; ++x) {
       if (!(surface.depth_m.at(x, y, 0) > 0)) continue;
       const Eigen::Vector3f p(surface.points_m.at(x, y, 0), surface.points_m.at(x, y, 1),

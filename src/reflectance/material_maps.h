@@ -43,6 +43,17 @@ struct WardShading {
 WardShading ward_shading(float alpha, const Eigen::Vector3f& p, const Eigen::Vector3f& n,
                          const Eigen::Vector3f& eye, const std::vector<render::PointLight>& lights);
 
+// How the voxels' refined albedos around a point are blended (interpolate_refined_kd()).
+struct AlbedoBlend {
+  // The edge-preserving smoothing's relative contrast; 0: the paper's trilinear interpolation
+  // alone.
+  float smoothing = 0;
+  // The weight of the caller's albedo for the point (the segment's refined albedo) as one more
+  // voxel's, in refined_albedo_weight()'s units (a voxel solved under light at 45 degrees or
+  // steeper weighs 1); 0: none, as the paper.
+  float segment_weight = 0;
+};
+
 // Refined kd at p: trilinear weights of the 8 observation voxels around p, restricted to those
 // of `segment` with a refined albedo, and of those to the reliable ones (solved under light
 // that is not grazing, ObservationGrid::refined_kd_reliable) where there are any; with none
@@ -58,10 +69,17 @@ WardShading ward_shading(float alpha, const Eigen::Vector3f& p, const Eigen::Vec
 // mean absolute channel difference relative to the estimate's mean (+ 0.01), with standard
 // deviation `smoothing` (a voxel 2 * smoothing off counts e^-2 as much). 0: the paper's
 // trilinear interpolation alone.
+// With `segment_weight` > 0 and without `unreliable_corners`, the caller's kd joins the reliable
+// voxels in both steps as one more albedo of that weight (under the trilinear and the wide
+// tents alike). A shrinkage towards the segment's albedo (paper 1 §3.5 assumes objects of
+// locally homogeneous material): where the voxels around p are few or solved under grazing light
+// it dominates, and the estimate no longer jumps between the voxels' and the segment's where
+// the last reliable voxel falls out of reach; among voxels lit well it hardly counts, and a
+// texture far from the segment's mean is beyond the smoothing's range weight.
 inline constexpr float kRefinedKdOutlier = 0.5f;
 bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& p, int segment,
                             Eigen::Vector3f& kd, bool unreliable_corners = true,
-                            float smoothing = 0);
+                            const AlbedoBlend& blend = {});
 
 // The observation voxels of the 4^3 around a trilinear cell (from the cell's first corner - 1,
 // x fastest), and of those the voxels of one segment with a refined albedo: pool indices, -1
@@ -83,15 +101,14 @@ struct PointMaterial {
 };
 
 // The material at surface point p: the segment of the voxel holding p (else of the nearest
-// labelled neighbour voxel), its fused Ward parameters, and the same with the refined kd (the
-// segment's fused refined kd where interpolate_refined_kd finds no reliable voxel; before the
-// segment has one, the unreliable voxels around p, else the network's kd), smoothed as
-// interpolate_refined_kd() with `albedo_smoothing`; false when p lies in no segment with a
-// material yet. Meant for many points of one model, such as a re-rendering's pixels or a mesh's
-// vertices, in an order where neighbours follow each other: it keeps the last point's
-// neighbourhood (64 voxels, which serve both its segment and its refined albedo), which the next
-// point mostly shares, and the grid blocks it found last (ObservationGrid::BlockCache). One per
-// thread; the grid must not change while it is in use.
+// labelled neighbour voxel), its fused Ward parameters, and the same with the refined kd
+// (interpolate_refined_kd() with `blend`, the segment's fused refined kd as the caller's; before
+// the segment has one, the unreliable voxels around p, else the network's kd); false when p lies
+// in no segment with a material yet. Meant for many points of one model, such as a
+// re-rendering's pixels or a mesh's vertices, in an order where neighbours follow each other: it
+// keeps the last point's neighbourhood (64 voxels, which serve both its segment and its refined
+// albedo), which the next point mostly shares, and the grid blocks it found last
+// (ObservationGrid::BlockCache). One per thread; the grid must not change while it is in use.
 class MaterialLookup {
  public:
   // The grid voxel the last point lay in, and the one segment it and its 26 neighbours hold
@@ -103,14 +120,14 @@ class MaterialLookup {
   };
 
   MaterialLookup(const ObservationGrid& grid, const SpecularEstimator& materials,
-                 float albedo_smoothing = 0)
-      : grid_(grid), materials_(materials), albedo_smoothing_(albedo_smoothing) {}
+                 const AlbedoBlend& blend = {})
+      : grid_(grid), materials_(materials), blend_(blend) {}
   bool operator()(const Eigen::Vector3f& p, PointMaterial& material);
 
  private:
   const ObservationGrid& grid_;
   const SpecularEstimator& materials_;
-  float albedo_smoothing_;
+  AlbedoBlend blend_;
   RefinedNeighbourhood around_;
   ObservationGrid::BlockCache blocks_;  // the grid blocks found last
   VoxelSegment last_voxel_;
@@ -119,6 +136,6 @@ class MaterialLookup {
 MaterialMaps render_material_maps(const fusion::SurfaceView& surface, const Pose& camera_to_world,
                                   const ObservationGrid& grid, const SpecularEstimator& materials,
                                   const std::vector<render::PointLight>& lights, float exposure,
-                                  float albedo_smoothing = 0);
+                                  const AlbedoBlend& blend = {});
 
 }  // namespace glint::reflectance

@@ -16,6 +16,7 @@
 #include "reflectance/albedo_refinement.h"
 #include "reflectance/depth_segmentation.h"
 #include "reflectance/hemicnn.h"
+#include "reflectance/material_maps.h"
 #include "reflectance/observation_grid.h"
 #include "reflectance/reflectance_volume.h"
 #include "reflectance/segment_map.h"
@@ -52,7 +53,8 @@ struct ReflectanceParams {
   // cosine (RefinedAlbedo::light_cosine) is unreliable: the re-rendering interpolates the
   // reliable voxels around it instead where there are any (reflectance/material_maps.h). 0.2
   // (78 degrees) is where a 2-degree normal error makes a 17 % albedo error; it was not tuned.
-  // 0 trusts every voxel, as the paper does.
+  // It also sets the weight of the segment's refined albedo in the blend (albedo_blend()).
+  // 0 trusts every voxel and blends in no segment albedo, as the paper does.
   float albedo_min_light_cosine = 0.2f;
   // Re-renderings and the mesh smooth the refined albedo between neighbouring voxels that agree
   // to about this relative contrast (interpolate_refined_kd in reflectance/material_maps.h);
@@ -98,7 +100,13 @@ class ReflectancePipeline {
   const StageTimings& geometry_timings() const { return geometry_.timings(); }
   const Intrinsics& intrinsics() const { return intrinsics_; }
   float exposure() const { return params_.exposure; }
-  float albedo_smoothing() const { return params_.albedo_smoothing; }
+  // How re-renderings and the mesh blend the refined albedos: the smoothing above, and the
+  // segment's refined albedo as one more voxel weighing as much as one solved under light at the
+  // reliability threshold (albedo_min_light_cosine; none where that is 0, as the paper).
+  AlbedoBlend albedo_blend() const {
+    return {params_.albedo_smoothing,
+            refined_albedo_weight(tangent_of(params_.albedo_min_light_cosine))};
+  }
   int frames_processed() const { return frame_; }
 
  private:

@@ -56,6 +56,7 @@ class Wall {
       grid_.has_refined_kd(seen.voxel) = true;
       grid_.refined_kd(seen.voxel) = albedo_at(grid_.position(seen.voxel));
       grid_.refined_kd_reliable(seen.voxel) = reliable_at(grid_.position(seen.voxel));
+      grid_.refined_kd_light_tangent(seen.voxel) = 0;  // lit head-on
     }
     return grid_;
   }
@@ -151,7 +152,7 @@ TEST(MaterialMaps, AlbedosSolvedUnderMoreGrazingLightWeighLess) {
               1e-5f);
   EXPECT_LT(kd.x(), even.x() - 0.05f);
   // The smoothing weighs them alike (the same edge, no range limit).
-  ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, kd, true, 1e6f));
+  ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, kd, true, {.smoothing = 1e6f}));
   EXPECT_LT(kd.x(), 0.3f + 0.6f * 0.25f);
 }
 
@@ -185,7 +186,7 @@ TEST(MaterialMaps, SmoothingAveragesTheScatterOfUniformAlbedosButKeepsATextureEd
       const Eigen::Vector3f p(x, y, 1.005f);
       Eigen::Vector3f trilinear, smoothed;
       ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, trilinear));
-      ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, smoothed, true, 0.2f));
+      ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, smoothed, true, {.smoothing = 0.2f}));
       trilinear_error += std::abs(trilinear.x() - 0.4f);
       smoothed_error += std::abs(smoothed.x() - 0.4f);
       ++points;
@@ -202,14 +203,14 @@ TEST(MaterialMaps, SmoothingAveragesTheScatterOfUniformAlbedosButKeepsATextureEd
       [](const Eigen::Vector3f& q) { return Eigen::Vector3f::Constant(q.x() < 0 ? 0.3f : 0.9f); });
   const Eigen::Vector3f dark(-0.015f, -0.007f, 1.005f);
   Eigen::Vector3f kd;
-  ASSERT_TRUE(interpolate_refined_kd(grid, dark, 3, kd, true, 0.2f));
+  ASSERT_TRUE(interpolate_refined_kd(grid, dark, 3, kd, true, {.smoothing = 0.2f}));
   EXPECT_NEAR(kd.x(), 0.3f, 1e-4f);
   // ... which a smoothing without a range limit would blend in.
-  ASSERT_TRUE(interpolate_refined_kd(grid, dark, 3, kd, true, 1e6f));
+  ASSERT_TRUE(interpolate_refined_kd(grid, dark, 3, kd, true, {.smoothing = 1e6f}));
   EXPECT_GT(kd.x(), 0.35f);
 }
 
-TEST(MaterialMaps, SegmentsRefinedAlbedoStandsWithoutVoxelsAndAKeptLookupAgreesWithAFreshOne) {
+TEST(MaterialMaps, SegmentsRefinedAlbedoStandsAloneOrAsOneMoreVoxelAndKeptLookupsAgree) {
   Wall wall;
   ObservationGrid& grid = wall.grid();
   SegmentMap segments;
@@ -251,6 +252,26 @@ TEST(MaterialMaps, SegmentsRefinedAlbedoStandsWithoutVoxelsAndAKeptLookupAgreesW
   ASSERT_TRUE(MaterialLookup(grid, estimator)(p, material));
   EXPECT_TRUE(material.refined.kd.isApprox(segment_kd, 1e-6f));
 
+  // The segment's albedo as one more voxel of weight 0.04: beside voxels lit head-on (weight 1,
+  // trilinear weights summing to s <= 1) it barely counts, (0.7 s + 0.04 kd) / (s + 0.04) ...
+  wall.with_albedo([](const Eigen::Vector3f&) { return Eigen::Vector3f::Constant(0.7f); });
+  const AlbedoBlend blend{.segment_weight = 0.04f};
+  ASSERT_TRUE(MaterialLookup(grid, estimator, blend)(p, material));
+  const float head_on = material.refined.kd.x();
+  EXPECT_LT(head_on, 0.7f);
+  EXPECT_GT(head_on, 0.68f);
+  // ... which gives s; beside voxels under grazing light (tangent 10, weight 0.01) it dominates.
+  const float s = 0.04f * (head_on - segment_kd.x()) / (0.7f - head_on);
+  for (const VisibleVoxel& seen : wall.visible()) grid.refined_kd_light_tangent(seen.voxel) = 10;
+  ASSERT_TRUE(MaterialLookup(grid, estimator, blend)(p, material));
+  EXPECT_NEAR(material.refined.kd.x(), (0.7f * 0.01f * s + 0.04f * 0.5f) / (0.01f * s + 0.04f),
+              1e-5f);
+  EXPECT_LT(material.refined.kd.x(), 0.6f);
+  // Without a segment albedo (unreliable corners in use) there is nothing to add.
+  Eigen::Vector3f kd = Eigen::Vector3f::Zero();
+  ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, kd, true, blend));
+  EXPECT_NEAR(kd.x(), 0.7f, 1e-6f);
+
   // A lookup that keeps the last point's neighbourhood gives what a fresh one gives, point by
   // point along a sweep that crosses cells and a strip of voxels relabelled to a segment
   // without a material.
@@ -259,13 +280,14 @@ TEST(MaterialMaps, SegmentsRefinedAlbedoStandsWithoutVoxelsAndAKeptLookupAgreesW
   });
   for (const VisibleVoxel& seen : wall.visible())
     if (std::abs(grid.position(seen.voxel).x() - 0.05f) < 0.015f) grid.segment(seen.voxel) = 5;
-  MaterialLookup lookup(grid, estimator, 0.2f);
+  const AlbedoBlend smoothing{.smoothing = 0.2f, .segment_weight = 0.04f};
+  MaterialLookup lookup(grid, estimator, smoothing);
   int found = 0, missing = 0;
   for (float x = -0.12f; x <= 0.12f; x += 0.0037f) {
     const Eigen::Vector3f q(x, 0.011f - 0.3f * x, 1.005f);
     PointMaterial kept, fresh;
     const bool with_material = lookup(q, kept);
-    ASSERT_EQ(with_material, MaterialLookup(grid, estimator, 0.2f)(q, fresh)) << x;
+    ASSERT_EQ(with_material, MaterialLookup(grid, estimator, smoothing)(q, fresh)) << x;
     EXPECT_EQ(kept.segment, fresh.segment) << x;
     if (!with_material) {
       ++missing;
