@@ -53,7 +53,8 @@ struct WeightedAlbedos {
 // more, a minority (at most a quarter) whose mean albedo is more than half off their median is
 // left out; a texture edge through the cell splits them more evenly and stays. (The 0.01 keeps
 // near-black ones from all being outliers of one another.)
-bool blend_without_outliers(const WeightedAlbedos& around, Eigen::Vector3f& kd) {
+// `total` receives the weights blended.
+bool blend_without_outliers(const WeightedAlbedos& around, Eigen::Vector3f& kd, float& total) {
   const int n = around.count;
   if (n == 0) return false;
   std::array<float, WeightedAlbedos::kCapacity> sorted = around.luminance;
@@ -75,6 +76,7 @@ bool blend_without_outliers(const WeightedAlbedos& around, Eigen::Vector3f& kd) 
   }
   if (!(weights > 1e-6f)) return false;
   kd = sum / weights;
+  total = weights;
   return true;
 }
 
@@ -134,28 +136,47 @@ float wide_tent(const Eigen::Vector3f& t, float dx, float dy, float dz) {
          (1 - 0.5f * std::fabs(t.z() - dz));
 }
 
+// The smoothing's range weight of an albedo: exp(-r^2 / 2), r = its mean absolute channel
+// difference from `reference` over contrast * (mean of the reference + 0.01).
+struct RangeWeight {
+  RangeWeight(const Eigen::Vector3f& reference, float contrast)
+      : reference(reference),
+        // Albedos lie in [0, 1], so r <= 3 * inverse_scale: capped at 1000, -r^2 / 2 stays within
+        // exp_nonpositive()'s range (a contrast that small weighs every other albedo at e^-50 or
+        // less anyway).
+        inverse_scale(std::min(1.0f / (contrast * (reference.mean() + 0.01f)) / 3.0f, 1000.0f)) {}
+  float operator()(const Eigen::Vector3f& albedo) const {
+    const float r = (albedo - reference).cwiseAbs().sum() * inverse_scale;
+    return exp_nonpositive(-0.5f * r * r);
+  }
+  Eigen::Vector3f reference;
+  float inverse_scale;
+};
+
+// The caller's albedo for a point (the segment's refined one) as one more voxel; weight 0: none.
+struct SegmentAlbedo {
+  float weight = 0;
+  Eigen::Vector3f kd = Eigen::Vector3f::Zero();
+};
+
 // Joint bilateral smoothing (Tomasi and Manduchi 1998) of the albedo kd interpolated at the point
-// at t: the reliable voxels of its 4^3 under the wide tent, each weighted further by
-// exp(-r^2 / 2), r = its mean absolute channel difference from kd over contrast * (mean of kd +
-// 0.01), and the `segment` albedo (none or one) likewise under its own weight. The voxel-to-voxel
-// scatter of eq. (7) averages out; a texture edge of more contrast is kept. The weights come from
-// one vectorised loop (AVX2 where the CPU has it): an exp per voxel and pixel was most of a
-// re-rendering's material lookups.
+// at t: the reliable voxels of its 4^3 under the wide tent and the segment's albedo, each
+// weighted further by RangeWeight(kd, contrast). The voxel-to-voxel scatter of eq. (7) averages
+// out; a texture edge of more contrast is kept. The voxels' weights come from one vectorised loop
+// (AVX2 where the CPU has it): an exp per voxel and pixel was most of a re-rendering's material
+// lookups.
 #if defined(__x86_64__)
 __attribute__((target_clones("arch=x86-64-v3", "default")))
 #endif
 void smooth_refined_kd(const RefinedNeighbourhood& around, const Eigen::Vector3f& t,
-                       float contrast, const WeightedAlbedos& segment, Eigen::Vector3f& kd) {
+                       float contrast, const SegmentAlbedo& segment, Eigen::Vector3f& kd) {
   const float red = kd.x(), green = kd.y(), blue = kd.z();
-  // Albedos lie in [0, 1], so r <= 3 * inverse_scale: capped at 1000, -r^2 / 2 stays within
-  // exp_nonpositive()'s range (a contrast that small weighs every other albedo at e^-50 or less
-  // anyway).
-  const float inverse_scale = std::min(1.0f / (contrast * (kd.mean() + 0.01f)) / 3.0f, 1000.0f);
+  const RangeWeight range(kd, contrast);
   std::array<float, 64> weight;
   for (int k = 0; k < around.reliable; ++k) {
     const float r = (std::fabs(around.red[k] - red) + std::fabs(around.green[k] - green) +
                      std::fabs(around.blue[k] - blue)) *
-                    inverse_scale;
+                    range.inverse_scale;
     weight[k] = around.weight[k] * wide_tent(t, around.dx[k], around.dy[k], around.dz[k]) *
                 exp_nonpositive(-0.5f * r * r);
   }
@@ -165,12 +186,9 @@ void smooth_refined_kd(const RefinedNeighbourhood& around, const Eigen::Vector3f
     sum += weight[k] * Eigen::Vector3f(around.red[k], around.green[k], around.blue[k]);
     weights += weight[k];
   }
-  for (int k = 0; k < segment.count; ++k) {
-    const float r = (segment.albedo[k] - kd).cwiseAbs().sum() * inverse_scale;
-    const float w = segment.weight[k] * exp_nonpositive(-0.5f * r * r);
-    sum += w * segment.albedo[k];
-    weights += w;
-  }
+  const float segment_weight = segment.weight * range(segment.kd);
+  sum += segment_weight * segment.kd;
+  weights += segment_weight;
   if (weights > 1e-6f) kd = sum / weights;
 }
 
@@ -178,9 +196,8 @@ void smooth_refined_kd(const RefinedNeighbourhood& around, const Eigen::Vector3f
 bool interpolate(const ObservationGrid& grid, const RefinedNeighbourhood& around,
                  const Eigen::Vector3f& t, Eigen::Vector3f& kd, bool unreliable_corners,
                  const AlbedoBlend& blend) {
-  // The caller's albedo as one more voxel (none, or one entry).
-  WeightedAlbedos segment;
-  if (!unreliable_corners && blend.segment_weight > 0) segment.add(blend.segment_weight, kd);
+  SegmentAlbedo segment;
+  if (!unreliable_corners && blend.smoothing > 0) segment = {blend.segment_weight, kd};
   WeightedAlbedos reliable, unreliable;
   for (int c = 0; c < 8; ++c) {
     const int v = voxel_at(around, c & 1, (c >> 1) & 1, (c >> 2) & 1);
@@ -200,9 +217,14 @@ bool interpolate(const ObservationGrid& grid, const RefinedNeighbourhood& around
                    {around.red[k], around.green[k], around.blue[k]});
   }
   if (reliable.count == 0 && !unreliable_corners) return false;
-  if (segment.count > 0) reliable.add(segment.weight[0], segment.albedo[0]);
-  if (!blend_without_outliers(reliable.count > 0 ? reliable : unreliable, kd)) return false;
-  if (blend.smoothing > 0) smooth_refined_kd(around, t, blend.smoothing, segment, kd);
+  float total = 0;
+  if (!blend_without_outliers(reliable.count > 0 ? reliable : unreliable, kd, total)) return false;
+  if (blend.smoothing > 0) {
+    // The segment's albedo joins the voxels' blend within the range weight.
+    const float weight = segment.weight * RangeWeight(kd, blend.smoothing)(segment.kd);
+    kd = (total * kd + weight * segment.kd) / (total + weight);
+    smooth_refined_kd(around, t, blend.smoothing, segment, kd);
+  }
   return true;
 }
 

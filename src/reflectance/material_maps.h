@@ -50,7 +50,8 @@ struct AlbedoBlend {
   float smoothing = 0;
   // The weight of the caller's albedo for the point (the segment's refined albedo) as one more
   // voxel's, in refined_albedo_weight()'s units (a voxel solved under light at 45 degrees or
-  // steeper weighs 1); 0: none, as the paper.
+  // steeper weighs 1), under the smoothing's range weight (so only with smoothing > 0); 0: none,
+  // as the paper.
   float segment_weight = 0;
 };
 
@@ -69,13 +70,15 @@ struct AlbedoBlend {
 // mean absolute channel difference relative to the estimate's mean (+ 0.01), with standard
 // deviation `smoothing` (a voxel 2 * smoothing off counts e^-2 as much). 0: the paper's
 // trilinear interpolation alone.
-// With `segment_weight` > 0 and without `unreliable_corners`, the caller's kd joins the reliable
-// voxels in both steps as one more albedo of that weight (under the trilinear and the wide
-// tents alike). A shrinkage towards the segment's albedo (paper 1 §3.5 assumes objects of
-// locally homogeneous material): where the voxels around p are few or solved under grazing light
-// it dominates, and the estimate no longer jumps between the voxels' and the segment's where
-// the last reliable voxel falls out of reach; among voxels lit well it hardly counts, and a
-// texture far from the segment's mean is beyond the smoothing's range weight.
+// With `segment_weight` > 0, smoothing and without `unreliable_corners`, the caller's kd joins
+// the reliable voxels in both steps as one more albedo of that weight (beside the trilinear and
+// the wide tents alike), times the range weight from the estimate so far. A shrinkage towards
+// the segment's albedo (paper 1 §3.5 assumes objects of locally homogeneous material): where the
+// voxels around p are few or solved under grazing light it dominates, and the estimate no longer
+// jumps between the voxels' and the segment's where the last reliable voxel falls out of reach;
+// among voxels lit well it hardly counts. An estimate far from the segment's albedo (a texture,
+// or two materials under one label) is beyond the range weight and keeps its own: without it, a
+// red head that glint's own segmentation merged with a grey table (office) took the mix.
 inline constexpr float kRefinedKdOutlier = 0.5f;
 bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& p, int segment,
                             Eigen::Vector3f& kd, bool unreliable_corners = true,

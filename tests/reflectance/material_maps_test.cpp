@@ -252,25 +252,39 @@ TEST(MaterialMaps, SegmentsRefinedAlbedoStandsAloneOrAsOneMoreVoxelAndKeptLookup
   ASSERT_TRUE(MaterialLookup(grid, estimator)(p, material));
   EXPECT_TRUE(material.refined.kd.isApprox(segment_kd, 1e-6f));
 
-  // The segment's albedo as one more voxel of weight 0.04: beside voxels lit head-on (weight 1,
-  // trilinear weights summing to s <= 1) it barely counts, (0.7 s + 0.04 kd) / (s + 0.04) ...
+  // The segment's albedo as one more voxel of weight 0.04, without a range limit (contrast
+  // 1e6): beside voxels lit head-on (weight 1, wide tents summing to s) it barely counts,
+  // (0.7 s + 0.04 kd) / (s + 0.04) ...
   wall.with_albedo([](const Eigen::Vector3f&) { return Eigen::Vector3f::Constant(0.7f); });
-  const AlbedoBlend blend{.segment_weight = 0.04f};
-  ASSERT_TRUE(MaterialLookup(grid, estimator, blend)(p, material));
+  const AlbedoBlend unlimited{.smoothing = 1e6f, .segment_weight = 0.04f};
+  ASSERT_TRUE(MaterialLookup(grid, estimator, unlimited)(p, material));
   const float head_on = material.refined.kd.x();
   EXPECT_LT(head_on, 0.7f);
   EXPECT_GT(head_on, 0.68f);
   // ... which gives s; beside voxels under grazing light (tangent 10, weight 0.01) it dominates.
   const float s = 0.04f * (head_on - segment_kd.x()) / (0.7f - head_on);
-  for (const VisibleVoxel& seen : wall.visible()) grid.refined_kd_light_tangent(seen.voxel) = 10;
-  ASSERT_TRUE(MaterialLookup(grid, estimator, blend)(p, material));
+  const auto grazing = [&] {
+    for (const VisibleVoxel& seen : wall.visible()) grid.refined_kd_light_tangent(seen.voxel) = 10;
+  };
+  grazing();
+  ASSERT_TRUE(MaterialLookup(grid, estimator, unlimited)(p, material));
   EXPECT_NEAR(material.refined.kd.x(), (0.7f * 0.01f * s + 0.04f * 0.5f) / (0.01f * s + 0.04f),
-              1e-5f);
+              1e-4f);
   EXPECT_LT(material.refined.kd.x(), 0.6f);
+  // Within a range limit (contrast 0.2) a segment albedo far from the voxels' (0.5 against
+  // 0.95) counts less.
+  wall.with_albedo([](const Eigen::Vector3f&) { return Eigen::Vector3f::Constant(0.95f); });
+  grazing();
+  ASSERT_TRUE(MaterialLookup(grid, estimator, unlimited)(p, material));
+  const float mixed = material.refined.kd.x();
+  ASSERT_TRUE(
+      MaterialLookup(grid, estimator, {.smoothing = 0.2f, .segment_weight = 0.04f})(p, material));
+  EXPECT_GT(material.refined.kd.x(), mixed + 0.05f);
+  EXPECT_LT(material.refined.kd.x(), 0.95f);
   // Without a segment albedo (unreliable corners in use) there is nothing to add.
   Eigen::Vector3f kd = Eigen::Vector3f::Zero();
-  ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, kd, true, blend));
-  EXPECT_NEAR(kd.x(), 0.7f, 1e-6f);
+  ASSERT_TRUE(interpolate_refined_kd(grid, p, 3, kd, true, unlimited));
+  EXPECT_NEAR(kd.x(), 0.95f, 1e-6f);
 
   // A lookup that keeps the last point's neighbourhood gives what a fresh one gives, point by
   // point along a sweep that crosses cells and a strip of voxels relabelled to a segment
