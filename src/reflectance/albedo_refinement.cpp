@@ -177,7 +177,6 @@ std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int 
 
   // Eq. (7) per observation and channel.
   RefinedAlbedo refined;
-  refined.light_cosine = cosines / std::sqrt(cosines * cosines + sines * sines);
   refined.light_tangent = sines / cosines;
   std::array<Channels, std::max(kMaxObservationsPerVoxel, kNetworkSize)> values;
   for (int j = 0; j < used; ++j) {

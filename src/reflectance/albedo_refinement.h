@@ -27,12 +27,12 @@ AlbedoAverage parse_albedo_average(const std::string& name);  // throws glint::E
 
 struct RefinedAlbedo {
   Eigen::Vector3f kd = Eigen::Vector3f::Zero();
-  // Cosine of the light's effective incidence angle, 1 / sqrt(1 + t^2) with
+  // Tangent of the light's effective incidence angle,
   // t = sum_l L_l sin(theta_i,l) / sum_l L_l cos(theta_i,l). Eq. (7) divides by the irradiance,
   // and a normal tilted by d changes that by about t d: under grazing light (cosine 0.2, t ~ 5)
   // a 2-degree tilt is a 17 % error in kd.
-  float light_cosine = 0.0f;
-  float light_tangent = 0.0f;  // t above, the same angle's tangent
+  float light_tangent = 0.0f;
+  float light_cosine() const { return 1.0f / std::sqrt(1.0f + light_tangent * light_tangent); }
 };
 
 // The weight of a voxel's refined albedo among its neighbours' (reflectance/material_maps.h):

@@ -157,6 +157,14 @@ struct RangeWeight {
 struct SegmentAlbedo {
   float weight = 0;
   Eigen::Vector3f kd = Eigen::Vector3f::Zero();
+
+  // Adds it to a weighted sum of albedos, its weight times its `range` weight.
+  void add_to(const RangeWeight& range, Eigen::Vector3f& sum, float& weights) const {
+    if (!(weight > 0)) return;
+    const float w = weight * range(kd);
+    sum += w * kd;
+    weights += w;
+  }
 };
 
 // Joint bilateral smoothing (Tomasi and Manduchi 1998) of the albedo kd interpolated at the point
@@ -186,9 +194,7 @@ void smooth_refined_kd(const RefinedNeighbourhood& around, const Eigen::Vector3f
     sum += weight[k] * Eigen::Vector3f(around.red[k], around.green[k], around.blue[k]);
     weights += weight[k];
   }
-  const float segment_weight = segment.weight * range(segment.kd);
-  sum += segment_weight * segment.kd;
-  weights += segment_weight;
+  segment.add_to(range, sum, weights);
   if (weights > 1e-6f) kd = sum / weights;
 }
 
@@ -221,8 +227,10 @@ bool interpolate(const ObservationGrid& grid, const RefinedNeighbourhood& around
   if (!blend_without_outliers(reliable.count > 0 ? reliable : unreliable, kd, total)) return false;
   if (blend.smoothing > 0) {
     // The segment's albedo joins the voxels' blend within the range weight.
-    const float weight = segment.weight * RangeWeight(kd, blend.smoothing)(segment.kd);
-    kd = (total * kd + weight * segment.kd) / (total + weight);
+    Eigen::Vector3f sum = total * kd;
+    float weights = total;
+    segment.add_to(RangeWeight(kd, blend.smoothing), sum, weights);
+    kd = sum / weights;
     smooth_refined_kd(around, t, blend.smoothing, segment, kd);
   }
   return true;

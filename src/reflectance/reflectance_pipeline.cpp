@@ -92,7 +92,7 @@ void ReflectancePipeline::refine_albedo_of_visible() {
       grid_.has_refined_kd(v) = refined.has_value();
       if (!refined) continue;
       grid_.refined_kd(v) = refined->kd.cwiseMax(0.0f).cwiseMin(1.0f);
-      grid_.refined_kd_reliable(v) = refined->light_cosine >= params_.albedo_min_light_cosine;
+      grid_.refined_kd_reliable(v) = refined->light_cosine() >= params_.albedo_min_light_cosine;
       grid_.refined_kd_light_tangent(v) = refined->light_tangent;
       if (grid_.refined_kd_reliable(v) && segment < segments) {
         const Eigen::Vector3f& kd = grid_.refined_kd(v);

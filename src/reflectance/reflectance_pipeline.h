@@ -50,7 +50,7 @@ struct ReflectanceParams {
   // over the paper's mean), departs from the paper's mean; --albedo-average mean restores it.
   AlbedoAverage albedo_average = AlbedoAverage::median;
   // A voxel whose albedo was solved under light more grazing than this effective incidence
-  // cosine (RefinedAlbedo::light_cosine) is unreliable: the re-rendering interpolates the
+  // cosine (RefinedAlbedo::light_cosine()) is unreliable: the re-rendering interpolates the
   // reliable voxels around it instead where there are any (reflectance/material_maps.h). 0.2
   // (78 degrees) is where a 2-degree normal error makes a 17 % albedo error; it was not tuned.
   // It also sets the weight of the segment's refined albedo in the blend (albedo_blend()).

@@ -123,10 +123,11 @@ TEST(AlbedoRefinement, LightCosineIsTheEffectiveIncidenceOfTheLights) {
     const RefinedAlbedo refined =
         *refine_albedo(&o, 1, Eigen::Vector3f::Zero(), normal, lights, {0, 0, 0}, 0.1f);
     // The tangent of the same angle.
-    EXPECT_NEAR(refined.light_tangent,
-                std::sqrt(1 - refined.light_cosine * refined.light_cosine) / refined.light_cosine,
-                1e-4f);
-    return refined.light_cosine;
+    EXPECT_NEAR(
+        refined.light_tangent,
+        std::sqrt(1 - refined.light_cosine() * refined.light_cosine()) / refined.light_cosine(),
+        1e-4f);
+    return refined.light_cosine();
   };
   // One light at 60 degrees from the normal: cos 60.
   std::vector<render::PointLight> lights(1);
