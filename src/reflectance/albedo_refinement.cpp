@@ -140,18 +140,24 @@ std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int 
                                            const Eigen::Vector3f& normal,
                                            const std::vector<render::PointLight>& lights,
                                            const Eigen::Vector3f& ks, float alpha,
-                                           AlbedoAverage average) {
+                                           AlbedoAverage average, float saturated_radiance) {
   std::array<const Observation*, kMaxObservationsPerVoxel> seen;  // from above the surface
   // Their directions as arrays, for the batched lobe.
   std::array<float, kMaxObservationsPerVoxel> x, y, z;
   int used = 0;
-  for (int k = 0; k < std::min(count, kMaxObservationsPerVoxel); ++k) {
-    const Eigen::Vector3f direction = observations[k].direction();
-    if (!(normal.dot(direction) > 0.0f)) continue;
-    x[used] = direction.x();
-    y[used] = direction.y();
-    z[used] = direction.z();
-    seen[used++] = &observations[k];
+  // Clipped observations only where every one is: a clipped channel bounds the radiance from
+  // below, so its eq. (7) albedo is too dark (by the clipped highlight's part, too).
+  for (const bool take_clipped : {false, true}) {
+    for (int k = 0; k < std::min(count, kMaxObservationsPerVoxel); ++k) {
+      const Eigen::Vector3f direction = observations[k].direction();
+      if (!(normal.dot(direction) > 0.0f)) continue;
+      if (!take_clipped && !(observations[k].colour().maxCoeff() < saturated_radiance)) continue;
+      x[used] = direction.x();
+      y[used] = direction.y();
+      z[used] = direction.z();
+      seen[used++] = &observations[k];
+    }
+    if (used > 0) break;
   }
   if (used == 0) return std::nullopt;
 

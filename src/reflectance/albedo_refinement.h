@@ -48,13 +48,16 @@ inline float tangent_of(float cosine) { return std::sqrt(1 - cosine * cosine) / 
 
 // Eq. (7) over the voxel's observations (those seen from above the surface, at most
 // kMaxObservationsPerVoxel), combined by `average`; nullopt when there is none or no light
-// reaches the surface point.
+// reaches the surface point. Observations with a channel at `saturated_radiance` or above have
+// clipped: their albedo would come out too dark, so they are left out unless all of them clipped
+// (their albedo then a lower bound).
 // No allocation.
 std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int count,
                                            const Eigen::Vector3f& position,
                                            const Eigen::Vector3f& normal,
                                            const std::vector<render::PointLight>& lights,
                                            const Eigen::Vector3f& ks, float alpha,
-                                           AlbedoAverage average = AlbedoAverage::mean);
+                                           AlbedoAverage average = AlbedoAverage::mean,
+                                           float saturated_radiance = INFINITY);
 
 }  // namespace glint::reflectance

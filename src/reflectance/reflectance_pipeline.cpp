@@ -15,10 +15,13 @@
 namespace glint::reflectance {
 namespace {
 
-// The lobe fit leaves out observations clipped by the sensor: an 8-bit (or normalised) pixel
-// saturates at 1, which is radiance 1 / exposure; 0.99 allows for rounding.
+// The radiance above which an observation has clipped: an 8-bit (or normalised) pixel saturates
+// at 1, which is radiance 1 / exposure; 0.99 allows for rounding.
+float saturated_radiance(float exposure) { return 0.99f / exposure; }
+
+// The lobe fit leaves out clipped observations (or takes them as bounds).
 SpecularParams with_saturation(SpecularParams params, float exposure) {
-  params.fit.saturated_radiance = 0.99f / exposure;
+  params.fit.saturated_radiance = saturated_radiance(exposure);
   return params;
 }
 
@@ -85,9 +88,10 @@ void ReflectancePipeline::refine_albedo_of_visible() {
       const int segment = grid_.segment(v);
       const SegmentMaterial* material = specular_.material(segment);
       if (!material) continue;
-      const auto refined = refine_albedo(
-          grid_.observations(v), grid_.observation_count(v), grid_.position(v), grid_.normal(v),
-          lights_, material->ward.ks, material->ward.alpha, params_.albedo_average);
+      const auto refined =
+          refine_albedo(grid_.observations(v), grid_.observation_count(v), grid_.position(v),
+                        grid_.normal(v), lights_, material->ward.ks, material->ward.alpha,
+                        params_.albedo_average, saturated_radiance(params_.exposure));
       // Each voxel is written by one iteration only: the due list holds it once.
       grid_.has_refined_kd(v) = refined.has_value();
       if (!refined) continue;

@@ -78,6 +78,48 @@ TEST(AlbedoRefinement, MedianIgnoresAMispredictedHighlight) {
   EXPECT_THROW(parse_albedo_average("mode"), Error);
 }
 
+TEST(AlbedoRefinement, ClippedObservationsCountOnlyWhereAllClipped) {
+  render::WardMaterial m;
+  m.kd = {0.6f, 0.3f, 0.1f};
+  m.ks = {0.3f, 0.3f, 0.3f};
+  m.alpha = 0.1f;
+  std::vector<render::PointLight> lights(1);
+  lights[0].position = {0.2, 1.0, 0.1};
+  lights[0].intensity = {2, 2, 2};
+  const Eigen::Vector3f position = Eigen::Vector3f::Zero(), normal = Eigen::Vector3f::UnitY();
+  // Eight views all round, and one at the light's mirror direction, whose highlight an 8-bit
+  // sensor clips at `saturated` (in every channel).
+  std::vector<Observation> obs;
+  for (int k = 0; k < 8; ++k) {
+    const Eigen::Vector3f direction =
+        Eigen::Vector3f(std::cos(0.8f * k), 1.0f, std::sin(0.8f * k)).normalized();
+    obs.emplace_back(observed(m, position, normal, direction, lights), direction, k);
+  }
+  const Eigen::Vector3f wi = (lights[0].position.cast<float>() - position).normalized();
+  const Eigen::Vector3f mirror = 2 * normal.dot(wi) * normal - wi;
+  const Eigen::Vector3f highlight = observed(m, position, normal, mirror, lights);
+  // A power of two, which the observation's binary16 colour holds exactly.
+  const float saturated = std::exp2(std::floor(std::log2(0.5f * highlight.minCoeff())));
+  ASSERT_GT(saturated, 2 * observed(m, position, normal, obs[0].direction(), lights).maxCoeff());
+  obs.emplace_back(Eigen::Vector3f::Constant(saturated), mirror, 8);
+
+  // Left out, the others give kd exactly; taken in, the clipped one drags the mean down.
+  const auto clean = refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks,
+                                   m.alpha, AlbedoAverage::mean, saturated);
+  const auto dragged = refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks,
+                                     m.alpha, AlbedoAverage::mean);
+  ASSERT_TRUE(clean && dragged);
+  EXPECT_TRUE(clean->kd.isApprox(m.kd, 1e-3f)) << clean->kd.transpose();  // binary16 colours
+  EXPECT_LT(dragged->kd.x(), m.kd.x() - 0.05f);
+
+  // Where every observation clipped, they are all there is: the same as taking them in.
+  const auto only_clipped = refine_albedo(&obs.back(), 1, position, normal, lights, m.ks, m.alpha,
+                                          AlbedoAverage::mean, saturated);
+  const auto taken = refine_albedo(&obs.back(), 1, position, normal, lights, m.ks, m.alpha);
+  ASSERT_TRUE(only_clipped && taken);
+  EXPECT_EQ(only_clipped->kd, taken->kd);
+}
+
 TEST(AlbedoRefinement, MedianIsThePerChannelMedianForEveryCount) {
   // Diffuse-only observations (ks 0) under one light straight above: observation j's eq. (7)
   // albedo is its colour * pi / E, so the result is the per-channel median of those.
