@@ -99,9 +99,12 @@ Scores score(const ImageF& truth, const ImageF& estimate, const ImageF& mask, co
   s.psnr_frame = capped_psnr(squared / (frame_pixels * truth.channels()));
   const Box around = grown(box, 2 * kSsimRadius, truth.width(), truth.height());
   const double around_pixels = double(around.x1 - around.x0) * (around.y1 - around.y0);
-  const double ssim_around =
-      denoise::ssim(crop(truth, around, &mask), crop(estimate, around, &mask));
+  const ImageF truth_alone = crop(truth, around, &mask);
+  const ImageF estimate_alone = crop(estimate, around, &mask);
+  const double ssim_around = denoise::ssim(truth_alone, estimate_alone);
   s.ssim_frame = (ssim_around * around_pixels + (frame_pixels - around_pixels)) / frame_pixels;
+  const ImageF around_mask = crop(mask, around);
+  s.ssim_object = denoise::ssim(truth_alone, estimate_alone, &around_mask);
   return s;
 }
 
@@ -123,6 +126,7 @@ Scores mean_of(const std::vector<Scores>& all) {
     mean.ssim += s.ssim / all.size();
     mean.psnr_frame += s.psnr_frame / all.size();
     mean.ssim_frame += s.ssim_frame / all.size();
+    mean.ssim_object += s.ssim_object / all.size();
   }
   return mean;
 }
@@ -133,7 +137,8 @@ nlohmann::json scores_json(const Scores& s) {
           {"psnr", s.psnr},
           {"ssim", s.ssim},
           {"psnr_frame", s.psnr_frame},
-          {"ssim_frame", s.ssim_frame}};
+          {"ssim_frame", s.ssim_frame},
+          {"ssim_object", s.ssim_object}};
 }
 
 }  // namespace

@@ -50,6 +50,7 @@ TEST(MaterialEvaluation, ExactEstimatesScorePerfectly) {
       EXPECT_NEAR(scores.at(q).ssim, 1.0, 1e-9);
       EXPECT_DOUBLE_EQ(scores.at(q).psnr_frame, 100.0);
       EXPECT_NEAR(scores.at(q).ssim_frame, 1.0, 1e-9);
+      EXPECT_NEAR(scores.at(q).ssim_object, 1.0, 1e-9);
     }
 }
 
@@ -98,6 +99,32 @@ TEST(MaterialEvaluation, WholeFrameSsimEqualsSsimOfTheMaskedFrames) {
       }
   EXPECT_NEAR(evaluation.average().at(Quantity::alpha).ssim_frame,
               denoise::ssim(truth_masked, estimate_masked), 1e-9);
+  // The object-alone SSIM is the same frames' SSIM averaged over the object's pixels.
+  ImageF object(kWidth, kHeight, 1);
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) object.at(x, y, 0) = t.segment.at(x, y, 0) == 1;
+  EXPECT_NEAR(evaluation.average().at(Quantity::alpha).ssim_object,
+              denoise::ssim(truth_masked, estimate_masked, &object), 1e-9);
+}
+
+TEST(MaterialEvaluation, ObjectSsimIgnoresWhatLiesAroundTheObject) {
+  // The frame split along its diagonal, so that object 1's box holds part of object 2. Object
+  // 1's estimate is exact, object 2's is off: object 1's crop SSIM sees object 2 in the windows
+  // across their border, its object-alone SSIM does not.
+  GroundTruthMaps t = truth();
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) t.segment.at(x, y, 0) = x * kHeight < y * kWidth ? 1 : 2;
+  const ImageF input(kWidth, kHeight, 3, 0.25f);
+  MaterialMaps estimate = exact(t, input);
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x)
+      if (t.segment.at(x, y, 0) == 2) estimate.ks.at(x, y, 0) = 0.6f;
+  MaterialEvaluation evaluation(10);
+  evaluation.add_frame(0, estimate, t, input);
+  const Scores ks = evaluation.table().at(1).at(Quantity::ks);
+  EXPECT_EQ(ks.l1, 0.0);
+  EXPECT_LT(ks.ssim, 0.99);
+  EXPECT_NEAR(ks.ssim_object, 1.0, 1e-9);
 }
 
 TEST(MaterialEvaluation, UncoveredAndTinyObjectsAreNotScored) {
