@@ -33,51 +33,42 @@ WardShading ward_shading(float alpha, const Eigen::Vector3f& p, const Eigen::Vec
 
 namespace {
 
-// Refined albedos around a point and their interpolation weights.
-struct WeightedAlbedos {
-  static constexpr int kCapacity = 64;  // the 4^3 voxels around a cell
-  int count = 0;
-  std::array<float, kCapacity> weight, luminance;
-  std::array<Eigen::Vector3f, kCapacity> albedo;
-
-  void add(float w, const Eigen::Vector3f& kd) {
-    weight[count] = w;
-    albedo[count] = kd;
-    luminance[count] = kd.mean();
-    ++count;
-  }
-};
-
-// Weighted mean of the albedos. A voxel whose normal or surface point misses a crease predicts
-// too little or too much irradiance, and its eq. (7) albedo comes out near 0 or 1: among four or
-// more, a minority (at most a quarter) whose mean albedo is more than half off their median is
-// left out; a texture edge through the cell splits them more evenly and stays. (The 0.01 keeps
-// near-black ones from all being outliers of one another.)
-// `total` receives the weights blended.
-bool blend_without_outliers(const WeightedAlbedos& around, Eigen::Vector3f& kd, float& total) {
-  const int n = around.count;
-  if (n == 0) return false;
-  std::array<float, WeightedAlbedos::kCapacity> sorted = around.luminance;
+// Marks which of n albedos, by their mean over the channels, a blend leaves out. A voxel whose
+// normal or surface point misses a crease predicts too little or too much irradiance, and its
+// eq. (7) albedo comes out near 0 or 1: among four or more, a minority (at most a quarter) whose
+// mean albedo is more than half off their median is left out; a texture edge through the cell
+// splits them more evenly and stays. (The 0.01 keeps near-black ones from all being outliers of
+// one another.)
+void mark_outliers(const float* luminance, int n, bool* outlier) {
+  std::fill(outlier, outlier + n, false);
+  if (n < 4) return;
+  std::array<float, 64> sorted;
+  std::copy(luminance, luminance + n, sorted.begin());
   std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.begin() + n);
-  const float median = sorted[n / 2];
-  std::array<bool, WeightedAlbedos::kCapacity> outlier;
+  const float median = sorted[std::size_t(n / 2)];
   int outliers = 0;
   for (int k = 0; k < n; ++k) {
-    outlier[k] = std::abs(around.luminance[k] - median) > kRefinedKdOutlier * median + 0.01f;
+    outlier[k] = std::abs(luminance[k] - median) > kRefinedKdOutlier * median + 0.01f;
     outliers += outlier[k];
   }
-  const bool leave_out = n >= 4 && 4 * outliers <= n;
-  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-  float weights = 0;
-  for (int k = 0; k < n; ++k) {
-    if (leave_out && outlier[k]) continue;
-    sum += around.weight[k] * around.albedo[k];
-    weights += around.weight[k];
+  if (4 * outliers > n) std::fill(outlier, outlier + n, false);  // no minority: all stay
+}
+
+// Drops the corners a blend of them leaves out (mark_outliers()), keeping their order.
+void drop_outliers(RefinedNeighbourhood::Corners& corners) {
+  std::array<float, 8> luminance;
+  std::array<bool, 8> outlier;
+  for (int i = 0; i < corners.count; ++i)
+    luminance[std::size_t(i)] = corners.kd[std::size_t(i)].mean();
+  mark_outliers(luminance.data(), corners.count, outlier.data());
+  int kept = 0;
+  for (int i = 0; i < corners.count; ++i) {
+    if (outlier[std::size_t(i)]) continue;
+    corners.corner[std::size_t(kept)] = corners.corner[std::size_t(i)];
+    corners.weight[std::size_t(kept)] = corners.weight[std::size_t(i)];
+    corners.kd[std::size_t(kept++)] = corners.kd[std::size_t(i)];
   }
-  if (!(weights > 1e-6f)) return false;
-  kd = sum / weights;
-  total = weights;
-  return true;
+  corners.count = kept;
 }
 
 // The trilinear cell of point p: its first corner voxel and p's coordinates within it in
@@ -102,6 +93,11 @@ void look_up(const ObservationGrid& grid, const Eigen::Vector3i& base, RefinedNe
   grid.find_voxels(base - Eigen::Vector3i::Ones(), 4, around.grid_voxels.data(), cache);
 }
 
+// The voxel at offset (dx, dy, dz) from the cell's first corner, each in [-1, 2].
+int voxel_at(const RefinedNeighbourhood& around, int dx, int dy, int dz) {
+  return around.voxels[std::size_t(((dz + 1) * 4 + dy + 1) * 4 + dx + 1)];
+}
+
 // Fills `around`'s refined albedos of `segment` (its voxels looked up), unless it holds them.
 void select_segment(const ObservationGrid& grid, int segment, RefinedNeighbourhood& around) {
   if (around.segment == segment) return;
@@ -122,11 +118,28 @@ void select_segment(const ObservationGrid& grid, int segment, RefinedNeighbourho
     around.dy[k] = float(i / 4 % 4 - 1);
     around.dz[k] = float(i / 16 - 1);
   }
-}
-
-// The voxel at offset (dx, dy, dz) from the cell's first corner, each in [-1, 2].
-int voxel_at(const RefinedNeighbourhood& around, int dx, int dy, int dz) {
-  return around.voxels[std::size_t(((dz + 1) * 4 + dy + 1) * 4 + dx + 1)];
+  around.reliable_corners.count = around.unreliable_corners.count = 0;
+  for (int c = 0; c < 8; ++c) {
+    const int v = voxel_at(around, c & 1, (c >> 1) & 1, (c >> 2) & 1);
+    if (v < 0) continue;
+    const bool reliable = grid.refined_kd_reliable(v);
+    RefinedNeighbourhood::Corners& corners =
+        reliable ? around.reliable_corners : around.unreliable_corners;
+    const std::size_t i = std::size_t(corners.count++);
+    corners.corner[i] = c;
+    corners.weight[i] = reliable ? refined_albedo_weight(grid.refined_kd_light_tangent(v)) : 1.0f;
+    corners.kd[i] = grid.refined_kd(v);
+  }
+  drop_outliers(around.reliable_corners);
+  drop_outliers(around.unreliable_corners);
+  if (around.reliable_corners.count > 0) return;
+  std::array<float, 64> luminance;
+  for (int k = 0; k < around.reliable; ++k)
+    luminance[std::size_t(k)] =
+        Eigen::Vector3f(around.red[std::size_t(k)], around.green[std::size_t(k)],
+                        around.blue[std::size_t(k)])
+            .mean();
+  mark_outliers(luminance.data(), around.reliable, around.reliable_outlier.data());
 }
 
 // The weight under a tent twice the voxel's width centred on the point at t in the cell, of the
@@ -199,38 +212,48 @@ void smooth_refined_kd(const RefinedNeighbourhood& around, const Eigen::Vector3f
 }
 
 // interpolate_refined_kd() at the point at t in the cell of `around`.
-bool interpolate(const ObservationGrid& grid, const RefinedNeighbourhood& around,
-                 const Eigen::Vector3f& t, Eigen::Vector3f& kd, bool unreliable_corners,
-                 const AlbedoBlend& blend) {
+bool interpolate(const RefinedNeighbourhood& around, const Eigen::Vector3f& t, Eigen::Vector3f& kd,
+                 bool unreliable_corners, const AlbedoBlend& blend) {
   SegmentAlbedo segment;
   if (!unreliable_corners && blend.smoothing > 0) segment = {blend.segment_weight, kd};
-  WeightedAlbedos reliable, unreliable;
-  for (int c = 0; c < 8; ++c) {
-    const int v = voxel_at(around, c & 1, (c >> 1) & 1, (c >> 2) & 1);
-    if (v < 0) continue;
-    const float weight = ((c & 1) ? t.x() : 1 - t.x()) * (((c >> 1) & 1) ? t.y() : 1 - t.y()) *
-                         (((c >> 2) & 1) ? t.z() : 1 - t.z());
-    if (grid.refined_kd_reliable(v))
-      reliable.add(weight * refined_albedo_weight(grid.refined_kd_light_tangent(v)),
-                   grid.refined_kd(v));
-    else
-      unreliable.add(weight, grid.refined_kd(v));
-  }
-  if (reliable.count == 0) {
-    // No corner is reliable: the reliable voxels one further out, under a tent twice as wide.
-    for (int k = 0; k < around.reliable; ++k)
-      reliable.add(around.weight[k] * wide_tent(t, around.dx[k], around.dy[k], around.dz[k]),
-                   {around.red[k], around.green[k], around.blue[k]});
-  }
-  if (reliable.count == 0 && !unreliable_corners) return false;
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
   float total = 0;
-  if (!blend_without_outliers(reliable.count > 0 ? reliable : unreliable, kd, total)) return false;
+  const auto add_corners = [&](const RefinedNeighbourhood::Corners& corners) {
+    for (int i = 0; i < corners.count; ++i) {
+      const int c = corners.corner[std::size_t(i)];
+      const float weight = ((c & 1) ? t.x() : 1 - t.x()) * (((c >> 1) & 1) ? t.y() : 1 - t.y()) *
+                           (((c >> 2) & 1) ? t.z() : 1 - t.z());
+      const float w = weight * corners.weight[std::size_t(i)];
+      sum += w * corners.kd[std::size_t(i)];
+      total += w;
+    }
+  };
+  if (around.reliable_corners.count > 0) {
+    add_corners(around.reliable_corners);
+  } else if (around.reliable > 0) {
+    // No corner is reliable: the reliable voxels one further out, under a tent twice as wide.
+    for (int k = 0; k < around.reliable; ++k) {
+      if (around.reliable_outlier[std::size_t(k)]) continue;
+      const float w = around.weight[std::size_t(k)] * wide_tent(t, around.dx[std::size_t(k)],
+                                                                around.dy[std::size_t(k)],
+                                                                around.dz[std::size_t(k)]);
+      sum += w * Eigen::Vector3f(around.red[std::size_t(k)], around.green[std::size_t(k)],
+                                 around.blue[std::size_t(k)]);
+      total += w;
+    }
+  } else if (unreliable_corners) {
+    add_corners(around.unreliable_corners);
+  } else {
+    return false;
+  }
+  if (!(total > 1e-6f)) return false;
+  kd = sum / total;
   if (blend.smoothing > 0) {
     // The segment's albedo joins the voxels' blend within the range weight.
-    Eigen::Vector3f sum = total * kd;
+    Eigen::Vector3f blended = total * kd;
     float weights = total;
-    segment.add_to(RangeWeight(kd, blend.smoothing), sum, weights);
-    kd = sum / weights;
+    segment.add_to(RangeWeight(kd, blend.smoothing), blended, weights);
+    kd = blended / weights;
     smooth_refined_kd(around, t, blend.smoothing, segment, kd);
   }
   return true;
@@ -245,7 +268,7 @@ bool interpolate_refined_kd(const ObservationGrid& grid, const Eigen::Vector3f& 
   RefinedNeighbourhood around;
   look_up(grid, cell.base, around);
   select_segment(grid, segment, around);
-  return interpolate(grid, around, cell.t, kd, unreliable_corners, blend);
+  return interpolate(around, cell.t, kd, unreliable_corners, blend);
 }
 
 namespace {
@@ -322,7 +345,7 @@ bool MaterialLookup::operator()(const Eigen::Vector3f& p, PointMaterial& materia
   material.fused = material.refined = fused->ward;
   if (fused->kd_refined) material.refined.kd = *fused->kd_refined;
   select_segment(grid_, material.segment, around_);
-  interpolate(grid_, around_, cell.t, material.refined.kd, !fused->kd_refined, blend_);
+  interpolate(around_, cell.t, material.refined.kd, !fused->kd_refined, blend_);
   return true;
 }
 

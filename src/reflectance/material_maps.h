@@ -96,6 +96,22 @@ struct RefinedNeighbourhood {
   // albedo, the offset from the cell's first corner and the voxel's refined_albedo_weight().
   int reliable = 0;
   std::array<float, 64> red, green, blue, dx, dy, dz, weight;
+  // Of those, the ones the wide tent's blend leaves out as outliers (set only where no corner
+  // is reliable, the one case that blend is made).
+  std::array<bool, 64> reliable_outlier;
+  // The cell's 8 trilinear corners of the segment with a refined albedo, the reliable and the
+  // unreliable apart, less the ones their blend leaves out as outliers, in corner order (bit 0:
+  // +x, bit 1: +y, bit 2: +z): the corner, its weight beside the trilinear one
+  // (refined_albedo_weight() for a reliable one, else 1) and its albedo. Which albedos are
+  // outliers depends on the set alone, not on the point's weights, so it is found once per cell
+  // and segment instead of at every point.
+  struct Corners {
+    int count = 0;
+    std::array<int, 8> corner;
+    std::array<float, 8> weight;
+    std::array<Eigen::Vector3f, 8> kd;
+  };
+  Corners reliable_corners, unreliable_corners;
 };
 
 struct PointMaterial {
