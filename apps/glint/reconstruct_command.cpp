@@ -50,14 +50,14 @@ const char* normals_name(const reflectance::ObservationGridParams& params) {
   return params.normal_from_neighbours ? kPlaneNormals : kGradientNormals;
 }
 
-// The model re-rendered from `pose`: ray cast (with gradient normals at silhouettes), its normals
-// smoothed within `normal_radius_m` (0: not), and shaded with the pipeline's materials and lights.
+// The model re-rendered from `pose` into `maps`: ray cast (with gradient normals at silhouettes),
+// its normals smoothed within `normal_radius_m` (0: not), and shaded with the pipeline's materials
+// and lights.
 // `fused_depth`: the depth of the frame just fused from `pose`, if it was, which the ray cast
 // starts from (fusion::raycast's depth hint). The three steps are timed into `timings`.
-reflectance::MaterialMaps render_model(const reflectance::ReflectancePipeline& pipeline,
-                                       const Intrinsics& intrinsics, const Pose& pose,
-                                       float normal_radius_m, StageTimings& timings,
-                                       const ImageF* fused_depth = nullptr) {
+void render_model(const reflectance::ReflectancePipeline& pipeline, const Intrinsics& intrinsics,
+                  const Pose& pose, float normal_radius_m, StageTimings& timings,
+                  reflectance::MaterialMaps& maps, const ImageF* fused_depth = nullptr) {
   Stopwatch watch;
   fusion::SurfaceView view = fusion::raycast(
       pipeline.geometry(), intrinsics, pose,
@@ -70,11 +70,10 @@ reflectance::MaterialMaps render_model(const reflectance::ReflectancePipeline& p
     timings.add("smooth_normals", watch.elapsed_ms());
   }
   watch.restart();
-  reflectance::MaterialMaps maps = reflectance::render_material_maps(
-      view, pose, pipeline.observations(), pipeline.materials(), pipeline.lights(),
-      pipeline.exposure(), pipeline.albedo_blend());
+  reflectance::render_material_maps(view, pose, pipeline.observations(), pipeline.materials(),
+                                    pipeline.lights(), pipeline.exposure(), pipeline.albedo_blend(),
+                                    maps);
   timings.add("shade", watch.elapsed_ms());
-  return maps;
 }
 
 struct ReconstructOptions {
@@ -178,6 +177,7 @@ void run_reconstruct(ReconstructOptions options) {
   // Per frame: read; render (the re-rendering alone), evaluate (scoring and pictures); per
   // extra view: render; mesh once.
   StageTimings command_timings, render_timings;
+  reflectance::MaterialMaps maps;  // every re-rendering's, its storage reused
   int lost = 0;
   {
     ProgressBar progress("reconstruct", frames);
@@ -202,9 +202,8 @@ void run_reconstruct(ReconstructOptions options) {
       if (!result.geometry.integrated) ++lost;
       if (result.geometry.integrated && (evaluate || render)) {
         watch.restart();
-        const reflectance::MaterialMaps maps =
-            render_model(pipeline, sequence.intrinsics, result.geometry.camera_to_world,
-                         options.render_normal_radius_m, render_timings, &frame.depth_m);
+        render_model(pipeline, sequence.intrinsics, result.geometry.camera_to_world,
+                     options.render_normal_radius_m, render_timings, maps, &frame.depth_m);
         command_timings.add("render", watch.elapsed_ms());
         watch.restart();
         if (evaluate) evaluation.add_frame(int(i), maps, *truth, frame.colour);
@@ -222,9 +221,8 @@ void run_reconstruct(ReconstructOptions options) {
     ProgressBar progress("views", views.size());
     for (std::size_t k = 0; k < views.size(); ++k) {
       Stopwatch watch;
-      const reflectance::MaterialMaps maps =
-          render_model(pipeline, sequence.intrinsics, views[k].pose, options.render_normal_radius_m,
-                       render_timings);
+      render_model(pipeline, sequence.intrinsics, views[k].pose, options.render_normal_radius_m,
+                   render_timings, maps);
       command_timings.add("render", watch.elapsed_ms());
       write_view_pictures((fs::path(options.output) / "views").string(), int(k), maps);
       progress.advance();

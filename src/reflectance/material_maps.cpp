@@ -355,20 +355,39 @@ void put(ImageF& image, int x, int y, const Eigen::Vector3f& value) {
   for (int c = 0; c < 3; ++c) image.at(x, y, c) = value[c];
 }
 
+// `image` as a width x height image of `channels`, its storage kept where it has that size.
+template <class T>
+void fit_size(Image<T>& image, int width, int height, int channels) {
+  if (image.width() != width || image.height() != height || image.channels() != channels)
+    image = Image<T>(width, height, channels);
+}
+
+// Zeroes row y of every channel.
+template <class T>
+void clear_row(Image<T>& image, int y) {
+  for (int c = 0; c < image.channels(); ++c)
+    std::fill_n(image.plane(c) + std::size_t(y) * image.width(), image.width(), T{});
+}
+
 }  // namespace
 
-MaterialMaps render_material_maps(const fusion::SurfaceView& surface, const Pose& camera_to_world,
-                                  const ObservationGrid& grid, const SpecularEstimator& materials,
-                                  const std::vector<render::PointLight>& lights, float exposure,
-                                  const AlbedoBlend& blend) {
+void render_material_maps(const fusion::SurfaceView& surface, const Pose& camera_to_world,
+                          const ObservationGrid& grid, const SpecularEstimator& materials,
+                          const std::vector<render::PointLight>& lights, float exposure,
+                          const AlbedoBlend& blend, MaterialMaps& maps) {
   const int width = surface.depth_m.width(), height = surface.depth_m.height();
-  MaterialMaps maps;
-  maps.kd = maps.kd_refined = maps.ks = maps.rgb = maps.rgb_refined = ImageF(width, height, 3);
-  maps.alpha = maps.covered = ImageF(width, height, 1);
-  maps.segment = Image<std::int32_t>(width, height, 1);
+  for (ImageF* image : {&maps.kd, &maps.kd_refined, &maps.ks, &maps.rgb, &maps.rgb_refined})
+    fit_size(*image, width, height, 3);
+  fit_size(maps.alpha, width, height, 1);
+  fit_size(maps.covered, width, height, 1);
+  fit_size(maps.segment, width, height, 1);
   const Eigen::Vector3f eye = camera_to_world.translation().cast<float>();
   parallel_for(std::size_t(height), [&](std::size_t row) {
     const int y = int(row);
+    for (ImageF* image : {&maps.kd, &maps.kd_refined, &maps.ks, &maps.rgb, &maps.rgb_refined,
+                          &maps.alpha, &maps.covered})
+      clear_row(*image, y);
+    clear_row(maps.segment, y);
     MaterialLookup lookup(grid, materials, blend);
     for (int x = 0; x < width; ++x) {
       if (!(surface.depth_m.at(x, y, 0) > 0)) continue;
@@ -394,7 +413,6 @@ MaterialMaps render_material_maps(const fusion::SurfaceView& surface, const Pose
       put(maps.rgb_refined, x, y, pixel(shading.radiance(material.refined)));
     }
   });
-  return maps;
 }
 
 }  // namespace glint::reflectance

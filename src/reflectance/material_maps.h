@@ -152,9 +152,12 @@ class MaterialLookup {
   VoxelSegment last_voxel_;
 };
 
-MaterialMaps render_material_maps(const fusion::SurfaceView& surface, const Pose& camera_to_world,
-                                  const ObservationGrid& grid, const SpecularEstimator& materials,
-                                  const std::vector<render::PointLight>& lights, float exposure,
-                                  const AlbedoBlend& blend = {});
+// Fills `maps` (0 where the model was not hit or has no material). Images of the view's size
+// keep their storage: a caller rendering view after view passes the same maps, and their 15 MB
+// (512 x 424) are not allocated and faulted in afresh, 6 ms of each re-rendering on one core.
+void render_material_maps(const fusion::SurfaceView& surface, const Pose& camera_to_world,
+                          const ObservationGrid& grid, const SpecularEstimator& materials,
+                          const std::vector<render::PointLight>& lights, float exposure,
+                          const AlbedoBlend& blend, MaterialMaps& maps);
 
 }  // namespace glint::reflectance
