@@ -1,6 +1,9 @@
 // glint: one executable, one subcommand per capability. Errors print one line and exit 1.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 #include <exception>
 
 #include "cli_support.h"
@@ -11,6 +14,16 @@
 #include "core/progress.h"
 
 int main(int argc, char** argv) {
+#if defined(__GLIBC__)
+  // Every frame allocates images of a few MB (the frame read, tracking's model view and pyramid,
+  // re-renderings). glibc hands such memory back to the kernel when it is freed (chunks above
+  // its mmap threshold, and a heap top beyond its trim threshold), so every allocation faulted
+  // in and zeroed its pages again: 6 ms of a 512x424 re-rendering's maps on one core. Kept in
+  // the heap, the next frame reuses them. (The TSDF and observation pools are mapped apart,
+  // core/pool_memory.h.)
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);  // the largest glibc takes
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
+#endif
   CLI::App app{
       "glint - practical real-time reflectance estimation toolkit.\n"
       "Online reflectance reconstruction from RGB-D (fuse, lights, reconstruct, hemicnn;\n"
