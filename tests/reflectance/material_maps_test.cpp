@@ -210,19 +210,31 @@ TEST(MaterialMaps, SmoothingAveragesTheScatterOfUniformAlbedosButKeepsATextureEd
   EXPECT_GT(kd.x(), 0.35f);
 }
 
+// The wall's voxels as segment 3, with a material from the HemiCNN (zero weights: some
+// material, not the tests' concern), lit from the camera.
+struct WallMaterial {
+  explicit WallMaterial(Wall& wall) : estimator(network, params()) {
+    segments.update(wall.grid(), wall.visible(), Image<std::int32_t>(80, 60, 1, 3), true);
+    lights[0].position = {0, 0, 0};
+    estimator.update(wall.grid(), segments, segments.frame_segments(), lights, 0);
+  }
+  static SpecularParams params() {
+    SpecularParams params;
+    params.min_observations = 1;
+    params.fit_lobe = false;
+    return params;
+  }
+  SegmentMap segments;
+  const HemiCnn network;
+  SpecularEstimator estimator;
+  std::vector<render::PointLight> lights{1};
+};
+
 TEST(MaterialMaps, SegmentsRefinedAlbedoStandsAloneOrAsOneMoreVoxelAndKeptLookupsAgree) {
   Wall wall;
   ObservationGrid& grid = wall.grid();
-  SegmentMap segments;
-  segments.update(grid, wall.visible(), Image<std::int32_t>(80, 60, 1, 3), true);
-  const HemiCnn network;  // zero weights: some material, not this test's concern
-  SpecularParams params;
-  params.min_observations = 1;
-  params.fit_lobe = false;
-  SpecularEstimator estimator(network, params);
-  std::vector<render::PointLight> lights(1);
-  lights[0].position = {0, 0, 0};
-  estimator.update(grid, segments, segments.frame_segments(), lights, 0);
+  WallMaterial wall_material(wall);
+  SpecularEstimator& estimator = wall_material.estimator;
   ASSERT_NE(estimator.material(3), nullptr);
   EXPECT_FALSE(estimator.material(3)->kd_refined);
 
@@ -312,6 +324,47 @@ TEST(MaterialMaps, SegmentsRefinedAlbedoStandsAloneOrAsOneMoreVoxelAndKeptLookup
   }
   EXPECT_GT(found, 40);
   EXPECT_GT(missing, 3);
+}
+
+TEST(MaterialMaps, RenderingIntoUsedMapsGivesWhatFreshMapsGive) {
+  Wall wall;
+  WallMaterial wall_material(wall);
+  ASSERT_NE(wall_material.estimator.material(3), nullptr);
+  wall.with_albedo(
+      [](const Eigen::Vector3f& q) { return Eigen::Vector3f(0.3f + q.x(), 0.4f, 0.5f); });
+  // The wall seen by the Wall's camera, over the whole image or its left half only.
+  const Intrinsics camera{80, 60, 120.0, 120.0, 39.5, 29.5};
+  const auto view_of = [&](int covered_width) {
+    fusion::SurfaceView view{ImageF(80, 60, 1), ImageF(80, 60, 3, NAN), ImageF(80, 60, 3, NAN),
+                             ImageF()};
+    for (int y = 0; y < 60; ++y)
+      for (int x = 0; x < covered_width; ++x) {
+        const float z = 1.005f;
+        const Eigen::Vector3f p((x - 39.5f) / 120.0f * z, (y - 29.5f) / 120.0f * z, z);
+        view.depth_m.at(x, y, 0) = z;
+        for (int c = 0; c < 3; ++c) {
+          view.points_m.at(x, y, c) = p[c];
+          view.normals.at(x, y, c) = c == 2 ? -1.0f : 0.0f;
+        }
+      }
+    return view;
+  };
+  const auto render = [&](const fusion::SurfaceView& view, MaterialMaps& maps) {
+    render_material_maps(view, Pose::Identity(), wall.grid(), wall_material.estimator,
+                         wall_material.lights, 1.0f, {.smoothing = 0.2f}, maps);
+  };
+  MaterialMaps used, fresh;
+  render(view_of(80), used);
+  ASSERT_EQ(used.covered.at(70, 30, 0), 1.0f);
+  render(view_of(40), used);
+  render(view_of(40), fresh);
+  EXPECT_EQ(used.covered.values(), fresh.covered.values());
+  EXPECT_EQ(used.segment.values(), fresh.segment.values());
+  EXPECT_EQ(used.kd_refined.values(), fresh.kd_refined.values());
+  EXPECT_EQ(used.rgb_refined.values(), fresh.rgb_refined.values());
+  EXPECT_EQ(used.alpha.values(), fresh.alpha.values());
+  EXPECT_EQ(used.covered.at(70, 30, 0), 0.0f) << "the half the second view misses is cleared";
+  EXPECT_EQ(used.covered.at(20, 30, 0), 1.0f);
 }
 
 // A concave right-angled corner seen from in front, as a room's: two faces meeting along
