@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -49,75 +50,81 @@ TEST(AlbedoRefinement, RecoversTheDiffuseAlbedoOfARenderedVoxel) {
   EXPECT_GT(diffuse_only->kd.x(), m.kd.x() + 0.01f);
 }
 
-TEST(AlbedoRefinement, MedianIgnoresAMispredictedHighlight) {
-  render::WardMaterial m;
-  m.kd = {0.5f, 0.4f, 0.3f};
-  m.ks = {0.2f, 0.2f, 0.2f};
-  m.alpha = 0.1f;
-  std::vector<render::PointLight> lights(1);
-  lights[0].position = {0.3, 1.5, 0.2};
-  lights[0].intensity = {2, 2, 2};
+// A voxel at the origin facing +y under one point light, of the material (kd, ks 0.2-0.3,
+// alpha 0.1), and what a camera sees of it.
+struct LitVoxel {
+  LitVoxel(const Eigen::Vector3f& kd, float ks, const Eigen::Vector3d& light) {
+    material.kd = kd;
+    material.ks = Eigen::Vector3f::Constant(ks);
+    material.alpha = 0.1f;
+    lights[0].position = light;
+    lights[0].intensity = {2, 2, 2};
+  }
+  Eigen::Vector3f seen_from(const Eigen::Vector3f& direction) const {
+    return observed(material, position, normal, direction, lights);
+  }
+  // Views all round, `step` radians apart in azimuth, 45 degrees above the surface.
+  Eigen::Vector3f view(int k, float step) const {
+    return Eigen::Vector3f(std::cos(step * k), 1.0f, std::sin(step * k)).normalized();
+  }
+  std::optional<RefinedAlbedo> refine(const std::vector<Observation>& obs, AlbedoAverage average,
+                                      float saturated_radiance = INFINITY) const {
+    return refine_albedo(obs.data(), int(obs.size()), position, normal, lights, material.ks,
+                         material.alpha, average, saturated_radiance);
+  }
+  render::WardMaterial material;
+  std::vector<render::PointLight> lights{1};
   const Eigen::Vector3f position = Eigen::Vector3f::Zero(), normal = Eigen::Vector3f::UnitY();
+};
+
+TEST(AlbedoRefinement, MedianIgnoresAMispredictedHighlight) {
+  const LitVoxel voxel({0.5f, 0.4f, 0.3f}, 0.2f, {0.3, 1.5, 0.2});
   std::vector<Observation> obs;
   for (int k = 0; k < 9; ++k) {
-    const Eigen::Vector3f direction =
-        Eigen::Vector3f(std::cos(0.7f * k), 1.0f, std::sin(0.7f * k)).normalized();
+    const Eigen::Vector3f direction = voxel.view(k, 0.7f);
     // Observation 4: a highlight the segment's ks and alpha do not predict.
-    obs.emplace_back(observed(m, position, normal, direction, lights) * (k == 4 ? 3.0f : 1.0f),
-                     direction, k);
+    obs.emplace_back(voxel.seen_from(direction) * (k == 4 ? 3.0f : 1.0f), direction, k);
   }
-  const auto median = refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks,
-                                    m.alpha, AlbedoAverage::median);
-  const auto mean = refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks,
-                                  m.alpha, AlbedoAverage::mean);
+  const auto median = voxel.refine(obs, AlbedoAverage::median);
+  const auto mean = voxel.refine(obs, AlbedoAverage::mean);
   ASSERT_TRUE(median && mean);
   // Each clean observation alone gives kd exactly; the median is one of them.
-  EXPECT_TRUE(median->kd.isApprox(m.kd, 1e-3f)) << median->kd.transpose();  // binary16 colours
-  EXPECT_GT(mean->kd.x(), m.kd.x() + 0.05f);
+  const Eigen::Vector3f& kd = voxel.material.kd;
+  EXPECT_TRUE(median->kd.isApprox(kd, 1e-3f)) << median->kd.transpose();  // binary16 colours
+  EXPECT_GT(mean->kd.x(), kd.x() + 0.05f);
   EXPECT_EQ(parse_albedo_average("median"), AlbedoAverage::median);
   EXPECT_THROW(parse_albedo_average("mode"), Error);
 }
 
 TEST(AlbedoRefinement, ClippedObservationsCountOnlyWhereAllClipped) {
-  render::WardMaterial m;
-  m.kd = {0.6f, 0.3f, 0.1f};
-  m.ks = {0.3f, 0.3f, 0.3f};
-  m.alpha = 0.1f;
-  std::vector<render::PointLight> lights(1);
-  lights[0].position = {0.2, 1.0, 0.1};
-  lights[0].intensity = {2, 2, 2};
-  const Eigen::Vector3f position = Eigen::Vector3f::Zero(), normal = Eigen::Vector3f::UnitY();
+  const LitVoxel voxel({0.6f, 0.3f, 0.1f}, 0.3f, {0.2, 1.0, 0.1});
   // Eight views all round, and one at the light's mirror direction, whose highlight an 8-bit
   // sensor clips at `saturated` (in every channel).
   std::vector<Observation> obs;
-  for (int k = 0; k < 8; ++k) {
-    const Eigen::Vector3f direction =
-        Eigen::Vector3f(std::cos(0.8f * k), 1.0f, std::sin(0.8f * k)).normalized();
-    obs.emplace_back(observed(m, position, normal, direction, lights), direction, k);
-  }
-  const Eigen::Vector3f wi = (lights[0].position.cast<float>() - position).normalized();
-  const Eigen::Vector3f mirror = 2 * normal.dot(wi) * normal - wi;
-  const Eigen::Vector3f highlight = observed(m, position, normal, mirror, lights);
+  for (int k = 0; k < 8; ++k)
+    obs.emplace_back(voxel.seen_from(voxel.view(k, 0.8f)), voxel.view(k, 0.8f), k);
+  const Eigen::Vector3f wi = voxel.lights[0].position.cast<float>().normalized();
+  const Eigen::Vector3f mirror = 2 * voxel.normal.dot(wi) * voxel.normal - wi;
   // A power of two, which the observation's binary16 colour holds exactly.
-  const float saturated = std::exp2(std::floor(std::log2(0.5f * highlight.minCoeff())));
-  ASSERT_GT(saturated, 2 * observed(m, position, normal, obs[0].direction(), lights).maxCoeff());
+  const float saturated =
+      std::exp2(std::floor(std::log2(0.5f * voxel.seen_from(mirror).minCoeff())));
+  ASSERT_GT(saturated, 2 * voxel.seen_from(voxel.view(0, 0.8f)).maxCoeff());
   obs.emplace_back(Eigen::Vector3f::Constant(saturated), mirror, 8);
 
   // Left out, the others give kd exactly; taken in, the clipped one drags the mean down.
-  const auto clean = refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks,
-                                   m.alpha, AlbedoAverage::mean, saturated);
-  const auto dragged = refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks,
-                                     m.alpha, AlbedoAverage::mean);
+  const auto clean = voxel.refine(obs, AlbedoAverage::mean, saturated);
+  const auto dragged = voxel.refine(obs, AlbedoAverage::mean);
   ASSERT_TRUE(clean && dragged);
-  EXPECT_TRUE(clean->kd.isApprox(m.kd, 1e-3f)) << clean->kd.transpose();  // binary16 colours
-  EXPECT_LT(dragged->kd.x(), m.kd.x() - 0.05f);
+  const Eigen::Vector3f& kd = voxel.material.kd;
+  EXPECT_TRUE(clean->kd.isApprox(kd, 1e-3f)) << clean->kd.transpose();  // binary16 colours
+  EXPECT_LT(dragged->kd.x(), kd.x() - 0.05f);
 
   // Where every observation clipped, they are all there is: the same as taking them in.
-  const auto only_clipped = refine_albedo(&obs.back(), 1, position, normal, lights, m.ks, m.alpha,
-                                          AlbedoAverage::mean, saturated);
-  const auto taken = refine_albedo(&obs.back(), 1, position, normal, lights, m.ks, m.alpha);
-  ASSERT_TRUE(only_clipped && taken);
-  EXPECT_EQ(only_clipped->kd, taken->kd);
+  const std::vector<Observation> only_clipped{obs.back()};
+  const auto lower_bound = voxel.refine(only_clipped, AlbedoAverage::mean, saturated);
+  const auto taken = voxel.refine(only_clipped, AlbedoAverage::mean);
+  ASSERT_TRUE(lower_bound && taken);
+  EXPECT_EQ(lower_bound->kd, taken->kd);
 }
 
 TEST(AlbedoRefinement, MedianIsThePerChannelMedianForEveryCount) {
