@@ -411,7 +411,8 @@ void register_reconstruct_command(CLI::App& app) {
             options->params.albedo_average = reflectance::parse_albedo_average(name);
           },
           "Combine a voxel's per-observation albedos (eq. 7) by their mean (the paper) or their "
-          "per-channel median (robust to mispredicted highlights)")
+          "per-channel median (robust to mispredicted highlights); either leaves out observations "
+          "with a clipped channel where the voxel has others")
       ->check(CLI::IsMember({"mean", "median"}))
       ->default_str(reflectance::albedo_average_name(params.albedo_average));
   command
