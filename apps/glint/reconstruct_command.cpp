@@ -291,6 +291,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"obs_spacing_deg", options.params.observations.min_observation_spacing_deg},
          {"obs_spacing_frames", options.params.observations.spacing_max_frames},
          {"albedo_average", reflectance::albedo_average_name(options.params.albedo_average)},
+         {"albedo_keep_clipped", options.params.albedo_keep_clipped},
          {"albedo_min_light_cosine", options.params.albedo_min_light_cosine},
          {"albedo_smoothing", options.params.albedo_smoothing},
          {"specular", specular_name(options.params.specular)},
@@ -411,10 +412,13 @@ void register_reconstruct_command(CLI::App& app) {
             options->params.albedo_average = reflectance::parse_albedo_average(name);
           },
           "Combine a voxel's per-observation albedos (eq. 7) by their mean (the paper) or their "
-          "per-channel median (robust to mispredicted highlights); either leaves out observations "
-          "with a clipped channel where the voxel has others")
+          "per-channel median (robust to mispredicted highlights)")
       ->check(CLI::IsMember({"mean", "median"}))
       ->default_str(reflectance::albedo_average_name(params.albedo_average));
+  command->add_flag("--albedo-keep-clipped", params.albedo_keep_clipped,
+                    "Solve eq. 7 from observations with a clipped channel too, as the paper (by "
+                    "default they are left out where a voxel has others: their albedo comes out "
+                    "too dark)");
   command
       ->add_option("--albedo-min-cosine", params.albedo_min_light_cosine,
                    "Trust a voxel's refined albedo only where its light's effective incidence "

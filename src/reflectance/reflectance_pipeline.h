@@ -49,6 +49,10 @@ struct ReflectanceParams {
   // median, chosen on the cubes scene (refined-kd L1 0.044 -> 0.041, refined-RGB PSNR +0.3 dB
   // over the paper's mean), departs from the paper's mean; --albedo-average mean restores it.
   AlbedoAverage albedo_average = AlbedoAverage::median;
+  // Whether eq. (7) takes observations with a clipped channel where a voxel has others too (the
+  // paper). By default they are left out: a clipped channel's albedo comes out too dark
+  // (refine_albedo()).
+  bool albedo_keep_clipped = false;
   // A voxel whose albedo was solved under light more grazing than this effective incidence
   // cosine (RefinedAlbedo::light_cosine()) is unreliable: the re-rendering interpolates the
   // reliable voxels around it instead where there are any (reflectance/material_maps.h). 0.2

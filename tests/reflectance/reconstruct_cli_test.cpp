@@ -52,6 +52,7 @@ TEST_F(ReconstructCli, WritesTheModelMaterialsLightsPicturesAndReport) {
             report["material_coverage"]["segments"].get<int>());
   // --device auto: the GPU where this build has CUDA and there is one.
   EXPECT_FLOAT_EQ(report["parameters"]["albedo_smoothing"].get<float>(), 0.2f);
+  EXPECT_FALSE(report["parameters"]["albedo_keep_clipped"].get<bool>());
   EXPECT_EQ(report["parameters"]["integration_device"],
             fusion::CudaIntegrator::available() ? "cuda" : "cpu");
   // The table is printed.
@@ -76,12 +77,14 @@ TEST_F(ReconstructCli, SaysWhichSegmentsGotNoMaterial) {
 TEST_F(ReconstructCli, OwnSegmentationRuns) {
   const CommandResult result =
       glint("reconstruct " + path("seq") + " --gt-lights --model " + path("model.json") +
-            " --gt-poses --eval-every 0 --segment-noise 1 -o " + path("own") + " --report " +
-            path("own.json"));
+            " --gt-poses --eval-every 0 --segment-noise 1 --albedo-keep-clipped -o " + path("own") +
+            " --report " + path("own.json"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const nlohmann::json materials = io::read_json(path("own") + "/materials.json");
   EXPECT_GE(materials["segments"].size(), 1u);
-  EXPECT_FLOAT_EQ(io::read_json(path("own.json"))["parameters"]["segment_noise"].get<float>(), 1);
+  const nlohmann::json parameters = io::read_json(path("own.json"))["parameters"];
+  EXPECT_FLOAT_EQ(parameters["segment_noise"].get<float>(), 1);
+  EXPECT_TRUE(parameters["albedo_keep_clipped"].get<bool>());
 }
 
 // Without --gt-poses the frames are tracked. The fixture's 24 frames span the whole camera path
