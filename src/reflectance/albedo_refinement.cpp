@@ -141,8 +141,9 @@ std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int 
                                            const std::vector<render::PointLight>& lights,
                                            const Eigen::Vector3f& ks, float alpha,
                                            AlbedoAverage average, float saturated_radiance) {
-  std::array<const Observation*, kMaxObservationsPerVoxel> seen;  // from above the surface
-  // Their directions as arrays, for the batched lobe.
+  // The observations seen from above the surface: their colours, and their directions as
+  // arrays, for the batched lobe.
+  std::array<Eigen::Vector3f, kMaxObservationsPerVoxel> colour;
   std::array<float, kMaxObservationsPerVoxel> x, y, z;
   int used = 0;
   // Clipped observations only where every one is: a clipped channel bounds the radiance from
@@ -151,11 +152,12 @@ std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int 
     for (int k = 0; k < std::min(count, kMaxObservationsPerVoxel); ++k) {
       const Eigen::Vector3f direction = observations[k].direction();
       if (!(normal.dot(direction) > 0.0f)) continue;
-      if (!take_clipped && !(observations[k].colour().maxCoeff() < saturated_radiance)) continue;
+      const Eigen::Vector3f seen = observations[k].colour();
+      if (!take_clipped && !(seen.maxCoeff() < saturated_radiance)) continue;
       x[used] = direction.x();
       y[used] = direction.y();
       z[used] = direction.z();
-      seen[used++] = &observations[k];
+      colour[used++] = seen;
     }
     if (used > 0) break;
   }
@@ -187,9 +189,8 @@ std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int 
   std::array<Channels, std::max(kMaxObservationsPerVoxel, kNetworkSize)> values;
   for (int j = 0; j < used; ++j) {
     values[j] = Channels{};
-    const Eigen::Vector3f colour = seen[j]->colour();
     for (int c = 0; c < 3; ++c)
-      values[j][c] = float(M_PI) * (colour[c] - ks[c] * specular[j][c]) / diffuse[c];
+      values[j][c] = float(M_PI) * (colour[j][c] - ks[c] * specular[j][c]) / diffuse[c];
   }
   if (average == AlbedoAverage::median) {
     refined.kd = channel_medians(values.data(), used);

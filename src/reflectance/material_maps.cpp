@@ -130,9 +130,13 @@ void select_segment(const ObservationGrid& grid, int segment, RefinedNeighbourho
     corners.weight[i] = reliable ? refined_albedo_weight(grid.refined_kd_light_tangent(v)) : 1.0f;
     corners.kd[i] = grid.refined_kd(v);
   }
+  // Outliers only of the one set a point's blend will take.
   drop_outliers(around.reliable_corners);
-  drop_outliers(around.unreliable_corners);
   if (around.reliable_corners.count > 0) return;
+  if (around.reliable == 0) {
+    drop_outliers(around.unreliable_corners);
+    return;
+  }
   std::array<float, 64> luminance;
   for (int k = 0; k < around.reliable; ++k)
     luminance[std::size_t(k)] =

@@ -100,11 +100,12 @@ struct RefinedNeighbourhood {
   // is reliable, the one case that blend is made).
   std::array<bool, 64> reliable_outlier;
   // The cell's 8 trilinear corners of the segment with a refined albedo, the reliable and the
-  // unreliable apart, less the ones their blend leaves out as outliers, in corner order (bit 0:
-  // +x, bit 1: +y, bit 2: +z): the corner, its weight beside the trilinear one
-  // (refined_albedo_weight() for a reliable one, else 1) and its albedo. Which albedos are
-  // outliers depends on the set alone, not on the point's weights, so it is found once per cell
-  // and segment instead of at every point.
+  // unreliable apart, in corner order (bit 0: +x, bit 1: +y, bit 2: +z): the corner, its weight
+  // beside the trilinear one (refined_albedo_weight() for a reliable one, else 1) and its albedo;
+  // less the ones their blend leaves out as outliers, in the one set a point's blend takes (the
+  // reliable corners, else the unreliable ones where there is no reliable voxel in the 4^3).
+  // Which albedos are outliers depends on the set alone, not on the point's weights, so it is
+  // found once per cell and segment instead of at every point.
   struct Corners {
     int count = 0;
     std::array<int, 8> corner;

@@ -76,6 +76,9 @@ void ReflectancePipeline::refine_albedo_of_visible() {
   const int segments = segment_map_.max_segment_id() + 1;
   tbb::enumerable_thread_specific<std::vector<FixedSums>> sums(std::size_t(segments),
                                                                FixedSums::Zero());
+  // Observations at or above this radiance have clipped (refine_albedo() leaves them out).
+  const float clipped =
+      params_.albedo_keep_clipped ? INFINITY : saturated_radiance(params_.exposure);
   parallel_for_chunks(albedo_due_.size(), 64, [&](std::size_t begin, std::size_t end) {
     std::vector<FixedSums>& segment_sums = sums.local();
     for (std::size_t i = begin; i < std::min(begin + kVoxelAhead, end); ++i)
@@ -90,8 +93,7 @@ void ReflectancePipeline::refine_albedo_of_visible() {
       if (!material) continue;
       const auto refined = refine_albedo(
           grid_.observations(v), grid_.observation_count(v), grid_.position(v), grid_.normal(v),
-          lights_, material->ward.ks, material->ward.alpha, params_.albedo_average,
-          params_.albedo_keep_clipped ? INFINITY : saturated_radiance(params_.exposure));
+          lights_, material->ward.ks, material->ward.alpha, params_.albedo_average, clipped);
       // Each voxel is written by one iteration only: the due list holds it once.
       grid_.has_refined_kd(v) = refined.has_value();
       if (!refined) continue;

@@ -335,12 +335,14 @@ TEST(MaterialMaps, RenderingIntoUsedMapsGivesWhatFreshMapsGive) {
   // The wall seen by the Wall's camera, over the whole image or its left half only.
   const Intrinsics camera{80, 60, 120.0, 120.0, 39.5, 29.5};
   const auto view_of = [&](int covered_width) {
-    fusion::SurfaceView view{ImageF(80, 60, 1), ImageF(80, 60, 3, NAN), ImageF(80, 60, 3, NAN),
-                             ImageF()};
-    for (int y = 0; y < 60; ++y)
+    const int width = camera.width, height = camera.height;
+    fusion::SurfaceView view{ImageF(width, height, 1), ImageF(width, height, 3, NAN),
+                             ImageF(width, height, 3, NAN), ImageF()};
+    for (int y = 0; y < height; ++y)
       for (int x = 0; x < covered_width; ++x) {
         const float z = 1.005f;
-        const Eigen::Vector3f p((x - 39.5f) / 120.0f * z, (y - 29.5f) / 120.0f * z, z);
+        const Eigen::Vector3f p(float((x - camera.cx) / camera.fx) * z,
+                                float((y - camera.cy) / camera.fy) * z, z);
         view.depth_m.at(x, y, 0) = z;
         for (int c = 0; c < 3; ++c) {
           view.points_m.at(x, y, c) = p[c];
