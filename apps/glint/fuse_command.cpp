@@ -162,7 +162,7 @@ void add_volume_options(CLI::App* command, fusion::VolumeParams& volume) {
       ->capture_default_str();
   command
       ->add_option("--blocks", volume.block_capacity,
-                   "Block pool capacity (4 KiB per block, 10 KiB where the volume keeps colour; "
+                   "Block pool capacity (2.5 KiB per block, 8.5 KiB where the volume keeps colour; "
                    "committed as used)")
       ->check(kPositive)
       ->capture_default_str();

@@ -32,11 +32,20 @@ T* grown(T*& buffer, std::size_t& capacity, std::size_t size) {
   return buffer;
 }
 
-constexpr std::size_t kBlockBytes = kVoxelsPerBlock * sizeof(float);
 constexpr std::size_t kPinnedChunkBlocks = 1024;
 
+// One side's pools, typed (CudaDevicePools keeps them as bytes).
 struct FieldPointers {
-  float* field[CudaDevicePools::kMaxFields];
+  float* sdf;
+  std::uint8_t* weight;
+  float* colour[3];
+
+  FieldPointers(char* const* fields, int count)
+      : sdf(reinterpret_cast<float*>(fields[0])),
+        weight(reinterpret_cast<std::uint8_t*>(fields[1])),
+        colour{} {
+    for (int c = 0; c + 2 < count; ++c) colour[c] = reinterpret_cast<float*>(fields[2 + c]);
+  }
 };
 
 // One CUDA block per TSDF block, one thread per voxel (voxel = (z * 8 + y) * 8 + x), so that a
@@ -54,18 +63,18 @@ __global__ void fuse_blocks(FrameConstants k, FieldPointers device, FieldPointer
     p[axis] = origin[axis] + k.step_z[axis] * float(z) + k.step_y[axis] * float(y) +
               float(x) * k.step_x[axis];
   const std::size_t voxel = std::size_t(blocks[blockIdx.x]) * kVoxelsPerBlock + v;
-  float sdf = device.field[0][voxel], weight = device.field[1][voxel];
+  float sdf = device.sdf[voxel], weight = float(device.weight[voxel]);
   const float weight_before = weight;
   const int pixel = fuse_voxel_projective(k, p[0], p[1], p[2], sdf, weight);
   if (pixel < 0) return;
-  device.field[0][voxel] = host.field[0][voxel] = sdf;
-  device.field[1][voxel] = host.field[1][voxel] = weight;
+  device.sdf[voxel] = host.sdf[voxel] = sdf;
+  device.weight[voxel] = host.weight[voxel] = std::uint8_t(weight);  // a whole number <= 255
   if (!colour) return;
   const std::size_t plane = std::size_t(k.width) * k.height;
   for (int c = 0; c < 3; ++c) {
     const float mean =
-        fuse_colour(device.field[2 + c][voxel], weight_before, colour[c * plane + pixel]);
-    device.field[2 + c][voxel] = host.field[2 + c][voxel] = mean;
+        fuse_colour(device.colour[c][voxel], weight_before, colour[c * plane + pixel]);
+    device.colour[c][voxel] = host.colour[c][voxel] = mean;
   }
 }
 
@@ -81,14 +90,21 @@ bool CudaDevicePools::device_present() {
 }
 
 CudaDevicePools::CudaDevicePools(const HostPools& host, std::size_t capacity_blocks)
-    : fields_(host.count), capacity_blocks_(capacity_blocks) {
+    : fields_(host.colour[0] ? 5 : 2), capacity_blocks_(capacity_blocks) {
   if (!device_present()) throw Error("CUDA", "", "no CUDA device is present (or no driver for it)");
-  std::copy_n(host.field, kMaxFields, host_);
+  host_[0] = reinterpret_cast<char*>(host.sdf);
+  voxel_bytes_[0] = sizeof(float);
+  host_[1] = reinterpret_cast<char*>(host.weight);
+  voxel_bytes_[1] = sizeof(std::uint8_t);
+  for (int f = 2; f < fields_; ++f) {
+    host_[f] = reinterpret_cast<char*>(host.colour[f - 2]);
+    voxel_bytes_[f] = sizeof(float);
+  }
 }
 
 CudaDevicePools::~CudaDevicePools() {
   for (void* range : pinned_) cudaHostUnregister(range);
-  for (float* pool : pools_) release(pool);
+  for (char* pool : pools_) release(pool);
   release(depth_);
   release(colour_);
   release(blocks_);
@@ -100,8 +116,8 @@ void CudaDevicePools::pin_host(std::size_t blocks) {
     const std::size_t first = pinned_blocks_;
     const std::size_t count = std::min(kPinnedChunkBlocks, capacity_blocks_ - first);
     for (int f = 0; f < fields_; ++f) {
-      void* range = host_[f] + first * kVoxelsPerBlock;
-      check(cudaHostRegister(range, count * kBlockBytes, cudaHostRegisterMapped),
+      void* range = host_[f] + first * block_bytes(f);
+      check(cudaHostRegister(range, count * block_bytes(f), cudaHostRegisterMapped),
             "pinning the host's voxel pools");
       pinned_.push_back(range);
       void* on_device = nullptr;
@@ -121,15 +137,15 @@ void CudaDevicePools::mirror(std::size_t blocks, bool upload) {
   if (blocks > device_blocks_) {
     const std::size_t room = std::min(capacity_blocks_, std::max(blocks, 2 * device_blocks_));
     for (int f = 0; f < fields_; ++f) {
-      float* pool = nullptr;
-      const cudaError_t status = cudaMalloc(&pool, room * kBlockBytes);
+      char* pool = nullptr;
+      const cudaError_t status = cudaMalloc(&pool, room * block_bytes(f));
       if (status != cudaSuccess)
         throw Error("CUDA", "device memory",
                     "no room for " + std::to_string(room) + " TSDF blocks (" +
-                        std::to_string(room * kBlockBytes * fields_ >> 20) +
-                        " MiB): " + cudaGetErrorString(status));
+                        std::to_string(room * block_bytes(f) >> 20) +
+                        " MiB for one of their pools): " + cudaGetErrorString(status));
       if (mirrored_)
-        check(cudaMemcpy(pool, pools_[f], mirrored_ * kBlockBytes, cudaMemcpyDeviceToDevice),
+        check(cudaMemcpy(pool, pools_[f], mirrored_ * block_bytes(f), cudaMemcpyDeviceToDevice),
               "growing the voxel pools");
       release(pools_[f]);
       pools_[f] = pool;
@@ -139,12 +155,13 @@ void CudaDevicePools::mirror(std::size_t blocks, bool upload) {
   // Chunk by chunk: a copy may not span two pinned ranges.
   for (std::size_t first = mirrored_; first < blocks;) {
     const std::size_t end = std::min(blocks, (first / kPinnedChunkBlocks + 1) * kPinnedChunkBlocks);
-    const std::size_t offset = first * kVoxelsPerBlock, bytes = (end - first) * kBlockBytes;
-    for (int f = 0; f < fields_; ++f)
+    for (int f = 0; f < fields_; ++f) {
+      const std::size_t offset = first * block_bytes(f), bytes = (end - first) * block_bytes(f);
       check(upload
                 ? cudaMemcpy(pools_[f] + offset, host_[f] + offset, bytes, cudaMemcpyHostToDevice)
                 : cudaMemset(pools_[f] + offset, 0, bytes),
             "mirroring new blocks");
+    }
     first = end;
   }
   mirrored_ = blocks;
@@ -168,9 +185,7 @@ void CudaDevicePools::fuse(const FrameConstants& k, const float* colour, const i
   check(cudaMemcpy(grown(origins_, origins_capacity_, 3 * count), origins,
                    3 * count * sizeof(float), cudaMemcpyHostToDevice),
         "uploading the block origins");
-  FieldPointers device{}, host{};
-  std::copy_n(pools_, fields_, device.field);
-  std::copy_n(host_, fields_, host.field);
+  const FieldPointers device(pools_, fields_), host(host_, fields_);
   fuse_blocks<<<unsigned(count), kVoxelsPerBlock>>>(on_device, device, host,
                                                     colour ? colour_ : nullptr, blocks_, origins_);
   check(cudaGetLastError(), "launching the fusion kernel");

@@ -4,6 +4,7 @@
 // them, and that kernel. Plain types only, so that nvcc never compiles Eigen. Every call is
 // synchronous and throws glint::Error naming the CUDA failure.
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "fusion/tsdf_kernels.h"
@@ -19,10 +20,11 @@ class CudaDevicePools {
   // Whether a CUDA device is present (false, not an error, without a driver).
   static bool device_present();
 
-  // A volume's host pools: field f's at block 0, for the first `count` fields.
+  // A volume's host pools at block 0 (TsdfVolume's types); colour all null where it keeps none.
   struct HostPools {
-    float* field[kMaxFields] = {};
-    int count = 0;
+    float* sdf = nullptr;
+    std::uint8_t* weight = nullptr;
+    float* colour[3] = {};
   };
 
   // `host` holds `capacity_blocks` blocks per field and must outlive this object.
@@ -34,8 +36,8 @@ class CudaDevicePools {
   // Mirrors blocks [0, blocks): blocks not yet on the GPU are copied from the host (`upload`)
   // or, when the caller knows them to be zero (freshly allocated), zeroed.
   void mirror(std::size_t blocks, bool upload);
-  // Field f's host pool (block 0).
-  const float* host_pool(int f) const { return host_[f]; }
+  // The host's distance pool (block 0).
+  const float* host_sdf() const { return reinterpret_cast<const float*>(host_[0]); }
 
   // Fuses `count` blocks (pool indices `blocks`, each mirrored; `origins`, 3 floats per block,
   // the camera coordinates of each block's voxel (0, 0, 0)) with the host depth image k.depth
@@ -49,14 +51,19 @@ class CudaDevicePools {
   // Pins the host pools of blocks [0, blocks), 1024 blocks (2 MiB a field) at a time.
   void pin_host(std::size_t blocks);
 
-  int fields_;
+  // Field f's bytes per block.
+  std::size_t block_bytes(int f) const { return voxel_bytes_[f] * kVoxelsPerBlock; }
+
+  int fields_ = 2;  // 5 with colour
   std::size_t capacity_blocks_;
-  float* host_[kMaxFields];
+  // Per field: the host pool, its bytes per voxel and the device pool, as bytes.
+  char* host_[kMaxFields] = {};
+  std::size_t voxel_bytes_[kMaxFields] = {};
   std::vector<void*> pinned_;  // registered host ranges
   std::size_t pinned_blocks_ = 0;
   std::size_t mirrored_ = 0;
   std::size_t device_blocks_ = 0;  // room in pools_
-  float* pools_[kMaxFields] = {};
+  char* pools_[kMaxFields] = {};
   // Per-frame input on the device, grown as needed.
   float* depth_ = nullptr;
   std::size_t depth_capacity_ = 0;

@@ -16,8 +16,8 @@ namespace {
 
 // The volume's host pools at block 0, in CudaDevicePools' order of fields.
 CudaDevicePools::HostPools host_pools(TsdfVolume& volume) {
-  if (!volume.has_colour()) return {{volume.sdf_m(0), volume.weight(0)}, 2};
-  return {{volume.sdf_m(0), volume.weight(0), volume.red(0), volume.green(0), volume.blue(0)}, 5};
+  if (!volume.has_colour()) return {volume.sdf_m(0), volume.weight(0)};
+  return {volume.sdf_m(0), volume.weight(0), {volume.red(0), volume.green(0), volume.blue(0)}};
 }
 
 }  // namespace
@@ -40,7 +40,7 @@ CudaIntegrator::~CudaIntegrator() = default;
 void CudaIntegrator::integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible,
                                       const ImageF& depth_m, const ImageF& colour,
                                       const Intrinsics& intrinsics, const Pose& camera_to_world) {
-  if (volume.sdf_m(0) != device_->pools.host_pool(0))
+  if (volume.sdf_m(0) != device_->pools.host_sdf())
     throw Error("CUDA", "integrate_blocks", "not the volume this integrator was made for");
   const FrameIntegration frame(volume, visible, depth_m, colour, intrinsics, camera_to_world);
   Device& device = *device_;

@@ -95,6 +95,7 @@ namespace {
 // per register instead.
 static_assert(kBlockSide == kLaneCount);
 constexpr Floats kLanes{0, 1, 2, 3, 4, 5, 6, 7};
+constexpr int kWeightsPerLine = 64 / sizeof(std::uint8_t);
 
 // Fuses kRows consecutive rows (row r's voxel centres are first[r] + i * step_x in camera
 // coordinates, i < kBlockSide; its voxels at r * kBlockSide in the arrays); fused_pixel[i] gets
@@ -104,7 +105,7 @@ constexpr Floats kLanes{0, 1, 2, 3, 4, 5, 6, 7};
 template <auto depth_at, int kRows>
 [[gnu::always_inline]] inline void integrate_rows(const FrameConstants& k,
                                                   const float (&first)[kRows][3], float* sdf_m,
-                                                  float* weight, std::int32_t* fused_pixel) {
+                                                  std::uint8_t* weight, std::int32_t* fused_pixel) {
   Floats z[kRows], u[kRows], v[kRows], d[kRows];
   Ints inside[kRows], pixel[kRows];
   for (int r = 0; r < kRows; ++r) {
@@ -124,12 +125,12 @@ template <auto depth_at, int kRows>
     const int offset = r * kBlockSide;
     Floats sdf, w;
     std::memcpy(&sdf, sdf_m + offset, sizeof(sdf));
-    std::memcpy(&w, weight + offset, sizeof(w));
+    load_bytes(weight + offset, w);
     Ints fused;
     fuse_voxel(d[r] - z[r], k.truncation_m + k.truncation_per_depth * d[r], k.max_weight,
                inside[r] & (d[r] >= k.depth_min) & (d[r] <= k.depth_max), sdf, w, fused);
     std::memcpy(sdf_m + offset, &sdf, sizeof(sdf));
-    std::memcpy(weight + offset, &w, sizeof(w));
+    store_bytes(w, weight + offset);
     const Ints result = fused ? pixel[r] : -1;
     std::memcpy(fused_pixel + offset, &result, sizeof(result));
   }
@@ -142,9 +143,9 @@ template <auto depth_at, int kRows>
 template <auto depth_at>
 [[gnu::always_inline]] inline void integrate_block(const FrameConstants& constants,
                                                    const float origin[3], float* sdf_m,
-                                                   float* weight, std::int32_t* fused_pixel,
+                                                   std::uint8_t* weight, std::int32_t* fused_pixel,
                                                    const float* next_sdf_m,
-                                                   const float* next_weight) {
+                                                   const std::uint8_t* next_weight) {
   // A local copy: through the reference, every store to the pools could alias the constants,
   // and each row reloaded all of them.
   const FrameConstants k = constants;
@@ -163,31 +164,29 @@ template <auto depth_at>
       for (int r = 0; r < kRows; ++r)
         for (int axis = 0; axis < 3; ++axis) first[r][axis] = row_first[axis][y + r];
       const int offset = (z * kBlockSide + y) * kBlockSide;
-      if (offset % kFloatsPerLine == 0) {
-        __builtin_prefetch(next_sdf_m + offset, 1);
-        __builtin_prefetch(next_weight + offset, 1);
-      }
+      if (offset % kFloatsPerLine == 0) __builtin_prefetch(next_sdf_m + offset, 1);
+      if (offset % kWeightsPerLine == 0) __builtin_prefetch(next_weight + offset, 1);
       integrate_rows<depth_at, kRows>(k, first, sdf_m + offset, weight + offset,
                                       fused_pixel + offset);
     }
   }
 }
 
-using BlockKernel = void (*)(const FrameConstants&, const float[3], float*, float*, std::int32_t*,
-                             const float*, const float*);
+using BlockKernel = void (*)(const FrameConstants&, const float[3], float*, std::uint8_t*,
+                             std::int32_t*, const float*, const std::uint8_t*);
 
 [[gnu::flatten]] void integrate_block_baseline(const FrameConstants& k, const float origin[3],
-                                               float* sdf_m, float* weight,
+                                               float* sdf_m, std::uint8_t* weight,
                                                std::int32_t* fused_pixel, const float* next_sdf_m,
-                                               const float* next_weight) {
+                                               const std::uint8_t* next_weight) {
   integrate_block<gather_lane_by_lane>(k, origin, sdf_m, weight, fused_pixel, next_sdf_m,
                                        next_weight);
 }
 
 #if defined(__x86_64__)
 [[gnu::target("arch=x86-64-v3"), gnu::flatten]] void integrate_block_x86_64_v3(
-    const FrameConstants& k, const float origin[3], float* sdf_m, float* weight,
-    std::int32_t* fused_pixel, const float* next_sdf_m, const float* next_weight) {
+    const FrameConstants& k, const float origin[3], float* sdf_m, std::uint8_t* weight,
+    std::int32_t* fused_pixel, const float* next_sdf_m, const std::uint8_t* next_weight) {
   integrate_block<gather_avx2>(k, origin, sdf_m, weight, fused_pixel, next_sdf_m, next_weight);
 }
 #endif
@@ -198,8 +197,8 @@ using BlockKernel = void (*)(const FrameConstants&, const float[3], float*, floa
 // compares into scalar code, so this one is written with intrinsics.) Per lane it is
 // integrate_rows()'s arithmetic in the same order.
 [[gnu::target("arch=x86-64-v4")]] void integrate_block_x86_64_v4(
-    const FrameConstants& constants, const float origin[3], float* sdf_m, float* weight,
-    std::int32_t* fused_pixel, const float* next_sdf_m, const float* next_weight) {
+    const FrameConstants& constants, const float origin[3], float* sdf_m, std::uint8_t* weight,
+    std::int32_t* fused_pixel, const float* next_sdf_m, const std::uint8_t* next_weight) {
   const FrameConstants k = constants;
   const __m512 lane_x = _mm512_setr_ps(0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7);
   const __m512 lane_y = _mm512_setr_ps(0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1);
@@ -227,7 +226,7 @@ using BlockKernel = void (*)(const FrameConstants&, const float[3], float*, floa
     for (int y = 0; y < kBlockSide; y += 2) {
       const int offset = (z * kBlockSide + y) * kBlockSide;
       __builtin_prefetch(next_sdf_m + offset, 1);
-      __builtin_prefetch(next_weight + offset, 1);
+      if (offset % kWeightsPerLine == 0) __builtin_prefetch(next_weight + offset, 1);
       const __m512 row = _mm512_add_ps(lane_y, _mm512_set1_ps(float(y)));
       __m512 p[3];
       for (int axis = 0; axis < 3; ++axis)
@@ -246,7 +245,9 @@ using BlockKernel = void (*)(const FrameConstants&, const float[3], float*, floa
       const __m512 d =
           _mm512_mask_i32gather_ps(_mm512_setzero_ps(), inside, pixel, k.depth, sizeof(float));
       __m512 sdf = _mm512_loadu_ps(sdf_m + offset);
-      __m512 w = _mm512_loadu_ps(weight + offset);
+      __m512 w = _mm512_maskz_cvtepi32_ps(
+          0xffff, _mm512_maskz_cvtepu8_epi32(
+                      0xffff, _mm_loadu_si128(reinterpret_cast<const __m128i*>(weight + offset))));
       const __m512 measured = _mm512_sub_ps(d, p[2]);
       const __m512 band = _mm512_fmadd_ps(truncation_per_depth, d, truncation);
       // fuse_voxel(): valid, not more than the band behind the surface, clamped in front.
@@ -261,7 +262,8 @@ using BlockKernel = void (*)(const FrameConstants&, const float[3], float*, floa
       sdf = _mm512_mask_div_ps(sdf, fused, _mm512_fmadd_ps(sdf, w, observation), total);
       w = _mm512_mask_min_ps(w, fused, total, max_weight);
       _mm512_storeu_ps(sdf_m + offset, sdf);
-      _mm512_storeu_ps(weight + offset, w);
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(weight + offset),
+                       _mm512_maskz_cvtepi32_epi8(0xffff, _mm512_maskz_cvttps_epi32(0xffff, w)));
       _mm512_storeu_si512(fused_pixel + offset, _mm512_mask_blend_epi32(fused, none, pixel));
     }
   }
@@ -353,7 +355,7 @@ void integrate_blocks(TsdfVolume& volume, const VisibleBlocks& visible, const Im
     if (!frame.fused_now(block, origin)) return;
     volume.count_fusion(block);
     float* sdf = volume.sdf_m(block);
-    float* weight = volume.weight(block);
+    std::uint8_t* weight = volume.weight(block);
     // The weights before this observation, for the colour average.
     std::array<float, kVoxelsPerBlock> weight_before;
     if (with_colour) std::copy_n(weight, kVoxelsPerBlock, weight_before.begin());

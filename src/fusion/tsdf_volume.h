@@ -6,7 +6,9 @@
 //
 // Voxel values: sdf_m, signed distance along the viewing ray in metres (positive in front of the
 // surface), clamped to the truncation band, or kUnobservedSdf in a voxel never observed; weight,
-// number of fused observations (saturating; 0 exactly where sdf_m is kUnobservedSdf);
+// number of fused observations (saturating at VolumeParams::max_weight, at most 255; 0 exactly
+// where sdf_m is kUnobservedSdf), one byte: integration streams a block's distances and weights
+// through memory every frame, and float weights were half of those bytes;
 // red, green, blue, weighted mean linear colour (only in volumes that keep colour).
 #include <Eigen/Core>
 #include <atomic>
@@ -59,12 +61,12 @@ class TsdfVolume {
   bool has_colour() const { return params_.colour; }
 
   float* sdf_m(int block) { return sdf_m_.get() + voxel_offset(block); }
-  float* weight(int block) { return weight_.get() + voxel_offset(block); }
+  std::uint8_t* weight(int block) { return weight_.get() + voxel_offset(block); }
   float* red(int block) { return red_.get() + voxel_offset(block); }
   float* green(int block) { return green_.get() + voxel_offset(block); }
   float* blue(int block) { return blue_.get() + voxel_offset(block); }
   const float* sdf_m(int block) const { return sdf_m_.get() + voxel_offset(block); }
-  const float* weight(int block) const { return weight_.get() + voxel_offset(block); }
+  const std::uint8_t* weight(int block) const { return weight_.get() + voxel_offset(block); }
   const float* red(int block) const { return red_.get() + voxel_offset(block); }
   const float* green(int block) const { return green_.get() + voxel_offset(block); }
   const float* blue(int block) const { return blue_.get() + voxel_offset(block); }
@@ -107,8 +109,8 @@ class TsdfVolume {
 
   VolumeParams params_;
   VoxelBlockHash hash_;
-  PoolArray<float> sdf_m_, weight_, red_, green_, blue_;
-  PoolArray<std::uint8_t> fusions_;
+  PoolArray<float> sdf_m_, red_, green_, blue_;
+  PoolArray<std::uint8_t> weight_, fusions_;
   std::unique_ptr<std::atomic<int>[]> last_visible_;
 };
 

@@ -15,6 +15,19 @@ namespace glint::fusion {
 inline constexpr int kLaneCount = 8;
 using Floats = float __attribute__((vector_size(kLaneCount * sizeof(float))));
 using Ints = std::int32_t __attribute__((vector_size(kLaneCount * sizeof(std::int32_t))));
+using Bytes = std::uint8_t __attribute__((vector_size(kLaneCount)));
+
+// Eight bytes as float lanes, and float lanes holding whole numbers in [0, 255] back into
+// bytes (the TSDF's weights; exact both ways).
+[[gnu::always_inline]] inline void load_bytes(const std::uint8_t* bytes, Floats& values) {
+  Bytes loaded;
+  std::memcpy(&loaded, bytes, sizeof(loaded));
+  values = __builtin_convertvector(loaded, Floats);
+}
+[[gnu::always_inline]] inline void store_bytes(const Floats& values, std::uint8_t* bytes) {
+  const Bytes stored = __builtin_convertvector(values, Bytes);
+  std::memcpy(bytes, &stored, sizeof(stored));
+}
 
 // nearest_pixel() of every lane of `valid`: clears the lanes whose (u, v) falls outside a
 // width x height image; `pixel` gets y * width + x, 0 in the lanes not valid.

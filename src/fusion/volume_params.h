@@ -16,10 +16,11 @@ struct VolumeParams {
   // VoxelHashing's getTruncation() with its defaults; the band grows with the sensor noise.
   double truncation_m = 0.02;
   double truncation_per_depth = 0.01;
-  float max_weight =
-      255;  // the running weight saturates here (VoxelHashing's integrationWeightMax)
-  // Fixed pool: at most this many blocks (4 KiB each, 10 KiB with colour); memory is committed
-  // as blocks are used.
+  // The running weight saturates here (VoxelHashing's integrationWeightMax); a whole number in
+  // [1, 255], as weights are kept in a byte.
+  float max_weight = 255;
+  // Fixed pool: at most this many blocks (2.5 KiB each, 8.5 KiB with colour); memory is
+  // committed as blocks are used.
   // Running out throws glint::Error (fusion/voxel_block_hash.h).
   std::size_t block_capacity = std::size_t{1} << 18;
   // Every n-th pixel of every n-th row allocates blocks along its ray (Open3D's DepthTouch uses
@@ -29,8 +30,8 @@ struct VolumeParams {
   double depth_min_m = 0.1;
   double depth_max_m = 4.0;
   // Keep a fused linear RGB per voxel (mesh and ray-cast colours). The reflectance pipeline
-  // keeps its colours in the observation grid and turns this off: each new block then zeroes
-  // 4 KiB instead of 10, which was 2 ms of its 5 ms block allocation per frame.
+  // keeps its colours in the observation grid and turns this off: each new block then fills
+  // 2.5 KiB instead of 8.5 (the colours were 2 ms of its 5 ms block allocation per frame).
   bool colour = true;
   // Far field: a block whose centre lies where one voxel spans less than `far_voxel_pixels`
   // pixels (depth > voxel_size_m * fx / far_voxel_pixels) is fused only every

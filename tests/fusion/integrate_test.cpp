@@ -76,6 +76,23 @@ TEST(Integrate, RepeatedFramesAverageAndColourFollows) {
   EXPECT_NEAR(volume.red(block)[voxel], 0.5, 1e-6);
 }
 
+// Weights are kept in a byte: the default clamp, 255, is reached and held, not wrapped to 0.
+TEST(Integrate, WeightsSaturateAtTheByteLimit) {
+  TsdfVolume volume(plane_params());
+  ASSERT_EQ(volume.params().max_weight, 255.0f);
+  VisibleBlocks visible;
+  for (int frame = 0; frame < 257; ++frame)
+    integrate(volume, wall_depth(frame < 255 ? 1.0 : 1.01), ImageF(), kCamera, Pose::Identity(),
+              visible);
+  const int block = volume.hash().find({0, 0, 12});
+  ASSERT_GE(block, 0);
+  const int voxel = 3 * 64;  // (0, 0, z = 0.99 m)
+  EXPECT_EQ(volume.weight(block)[voxel], 255);
+  // 255 observations of 0.01 m, then two of 0.02 m, each averaged in at weight 255.
+  const double after_one = (0.01 * 255 + 0.02) / 256, after_two = (after_one * 255 + 0.02) / 256;
+  EXPECT_NEAR(volume.sdf_m(block)[voxel], after_two, 1e-6);
+}
+
 // The vectorised block kernel (AVX-512, AVX2 or baseline, whichever this CPU runs) fuses every
 // voxel as the scalar rule does, under a tilted camera, a depth that varies from pixel to pixel
 // with holes and out-of-range values, the band growing with depth and the weight clamp reached.
@@ -199,6 +216,13 @@ TEST(Integrate, MismatchedImagesAndBadParametersAreErrors) {
   bad.far_fusion_every = 0;
   const Error error = test::error_of([&] { TsdfVolume{bad}; });
   EXPECT_NE(std::string(error.what()).find("far_fusion_every"), std::string::npos);
+  // Weights are whole counts in a byte.
+  for (const float max_weight : {0.0f, 2.5f, 256.0f}) {
+    bad = plane_params();
+    bad.max_weight = max_weight;
+    const Error weight_error = test::error_of([&] { TsdfVolume{bad}; });
+    EXPECT_NE(std::string(weight_error.what()).find("max_weight"), std::string::npos) << max_weight;
+  }
 }
 
 TEST(Integrate, FarFieldBlocksAreFusedEveryNthFrameStaggered) {
@@ -213,7 +237,7 @@ TEST(Integrate, FarFieldBlocksAreFusedEveryNthFrameStaggered) {
   for (int y = 0; y < kCamera.height; ++y)
     for (int x = kCamera.width / 2; x < kCamera.width; ++x) depth.at(x, y, 0) = 1.6f;
   const auto fused_times = [&](int block) {  // the largest weight in the block
-    const float* weight = volume.weight(block);
+    const std::uint8_t* weight = volume.weight(block);
     return int(*std::max_element(weight, weight + kVoxelsPerBlock));
   };
   const auto is_far = [&](int block) {

@@ -109,7 +109,7 @@ TEST(MarchingCubes, UnobservedVoxelsEmitNothing) {
   EXPECT_TRUE(extract_mesh(volume).vertices.empty()) << "a new block is unobserved";
   // Observed: +1 cm everywhere but -1 cm at voxel 0, whose cubes then cross the surface.
   std::fill_n(volume.sdf_m(block), kVoxelsPerBlock, 0.01f);
-  std::fill_n(volume.weight(block), kVoxelsPerBlock, 1.0f);
+  std::fill_n(volume.weight(block), kVoxelsPerBlock, std::uint8_t{1});
   volume.sdf_m(block)[0] = -0.01f;
   EXPECT_FALSE(extract_mesh(volume).vertices.empty());
   volume.sdf_m(block)[0] = kUnobservedSdf;

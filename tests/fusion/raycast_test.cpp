@@ -145,7 +145,7 @@ TEST(Raycast, RaysCrossMetresOfEmptySpaceToAFarWall) {
     const int near_block = volume->allocate(b);
     ASSERT_GE(near_block, 0);
     std::fill_n(volume->sdf_m(near_block), kVoxelsPerBlock, 0.04f);
-    std::fill_n(volume->weight(near_block), kVoxelsPerBlock, 1.0f);
+    std::fill_n(volume->weight(near_block), kVoxelsPerBlock, std::uint8_t{1});
   }
   const SurfaceView view = raycast(*volume, kCamera, Pose::Identity());
   for (int y = 0; y < kCamera.height; ++y)

@@ -57,7 +57,7 @@ TEST(TsdfSampler, ACellAcrossBlockCornersReadsEachVoxelFromItsBlock) {
   const int block = single.allocate({0, 0, 0});
   ASSERT_GE(block, 0);
   std::fill_n(single.sdf_m(block), kVoxelsPerBlock, 0.02f);
-  std::fill_n(single.weight(block), kVoxelsPerBlock, 1.0f);
+  std::fill_n(single.weight(block), kVoxelsPerBlock, std::uint8_t{1});
   TsdfSampler reader(single);
   float value = 0;
   EXPECT_TRUE(reader.trilinear(Eigen::Vector3f(0.0652f, 0.0421f, 0.0133f), value));
@@ -115,7 +115,7 @@ TEST(TsdfSampler, ABlockOfTheSameParityIsLookedUpAfresh) {
   float sdf = 0;
   EXPECT_EQ(sampler.voxel(3, 3, 3, sdf), TsdfSampler::Sample::unobserved) << "not yet fused";
   std::fill_n(volume.sdf_m(block), kVoxelsPerBlock, 0.01f);
-  std::fill_n(volume.weight(block), kVoxelsPerBlock, 1.0f);
+  std::fill_n(volume.weight(block), kVoxelsPerBlock, std::uint8_t{1});
   EXPECT_EQ(sampler.voxel(3, 3, 3, sdf), TsdfSampler::Sample::observed);
   EXPECT_EQ(sampler.voxel(19, 3, 3, sdf), TsdfSampler::Sample::unallocated);
   EXPECT_EQ(sampler.voxel(3, 3, 3, sdf), TsdfSampler::Sample::observed);
@@ -164,7 +164,7 @@ TEST(BlockOccupancy, HoldsEveryAllocatedBlockAndRulesOutTheRest) {
   // A sampler told of the occupancy reads the same samples as one that asks the hash.
   const int block = volume.hash().find({1, 1, 1});
   std::fill_n(volume.sdf_m(block), kVoxelsPerBlock, 0.02f);
-  std::fill_n(volume.weight(block), kVoxelsPerBlock, 1.0f);
+  std::fill_n(volume.weight(block), kVoxelsPerBlock, std::uint8_t{1});
   TsdfSampler plain(volume), told(volume, &occupancy);
   for (int x = 0; x < 40; ++x) {
     float a = 0, b = 0;
