@@ -48,7 +48,7 @@ class CudaDevicePools {
             std::size_t count);
 
  private:
-  // Pins the host pools of blocks [0, blocks), 1024 blocks (2 MiB a field) at a time.
+  // Pins the host pools of blocks [0, blocks), 1024 blocks (2 MiB of distances) at a time.
   void pin_host(std::size_t blocks);
 
   // Field f's bytes per block.
