@@ -25,6 +25,12 @@ class Image {
   bool same_size(const Image& other) const {
     return width_ == other.width_ && height_ == other.height_;
   }
+  // Makes this a width x height image of `channels`: zero-filled where its size changes; where it
+  // has that size already it keeps its storage and values (per-frame buffers, reused).
+  void ensure_size(int width, int height, int channels) {
+    if (width != width_ || height != height_ || channels != channels_)
+      *this = Image(width, height, channels);
+  }
 
   T& at(int x, int y, int c) { return data_[index(x, y, c)]; }
   const T& at(int x, int y, int c) const { return data_[index(x, y, c)]; }

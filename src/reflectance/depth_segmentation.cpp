@@ -241,10 +241,8 @@ const DepthSegmentation& DepthSegmenter::segment(const ImageF& depth,
                                                  const Intrinsics& intrinsics) {
   width_ = depth.width();
   height_ = depth.height();
-  if (result_.edges.width() != width_ || result_.edges.height() != height_) {
-    result_.edges = Image<std::uint8_t>(width_, height_, 1);
-    result_.labels = Image<std::int32_t>(width_, height_, 1);
-  }
+  result_.edges.ensure_size(width_, height_, 1);
+  result_.labels.ensure_size(width_, height_, 1);
   compute_vertices_and_normals(depth, intrinsics);
   detect_edges();
   label_components();

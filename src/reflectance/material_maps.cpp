@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 
 #include "core/fast_exp.h"
 #include "core/parallel.h"
@@ -359,13 +360,6 @@ void put(ImageF& image, int x, int y, const Eigen::Vector3f& value) {
   for (int c = 0; c < 3; ++c) image.at(x, y, c) = value[c];
 }
 
-// `image` as a width x height image of `channels`, its storage kept where it has that size.
-template <class T>
-void fit_size(Image<T>& image, int width, int height, int channels) {
-  if (image.width() != width || image.height() != height || image.channels() != channels)
-    image = Image<T>(width, height, channels);
-}
-
 // Zeroes row y of every channel.
 template <class T>
 void clear_row(Image<T>& image, int y) {
@@ -380,17 +374,20 @@ void render_material_maps(const fusion::SurfaceView& surface, const Pose& camera
                           const std::vector<render::PointLight>& lights, float exposure,
                           const AlbedoBlend& blend, MaterialMaps& maps) {
   const int width = surface.depth_m.width(), height = surface.depth_m.height();
-  for (ImageF* image : {&maps.kd, &maps.kd_refined, &maps.ks, &maps.rgb, &maps.rgb_refined})
-    fit_size(*image, width, height, 3);
-  fit_size(maps.alpha, width, height, 1);
-  fit_size(maps.covered, width, height, 1);
-  fit_size(maps.segment, width, height, 1);
+  // The float maps and their channels.
+  const std::array<std::pair<ImageF*, int>, 7> float_maps{{{&maps.kd, 3},
+                                                           {&maps.kd_refined, 3},
+                                                           {&maps.ks, 3},
+                                                           {&maps.rgb, 3},
+                                                           {&maps.rgb_refined, 3},
+                                                           {&maps.alpha, 1},
+                                                           {&maps.covered, 1}}};
+  for (const auto& [image, channels] : float_maps) image->ensure_size(width, height, channels);
+  maps.segment.ensure_size(width, height, 1);
   const Eigen::Vector3f eye = camera_to_world.translation().cast<float>();
   parallel_for(std::size_t(height), [&](std::size_t row) {
     const int y = int(row);
-    for (ImageF* image : {&maps.kd, &maps.kd_refined, &maps.ks, &maps.rgb, &maps.rgb_refined,
-                          &maps.alpha, &maps.covered})
-      clear_row(*image, y);
+    for (const auto& [image, channels] : float_maps) clear_row(*image, y);
     clear_row(maps.segment, y);
     MaterialLookup lookup(grid, materials, blend);
     for (int x = 0; x < width; ++x) {

@@ -128,8 +128,7 @@ const Image<std::int32_t>& ReflectancePipeline::segment_frame(const ImageF& dept
       depth_segmenter_.segment(depth, fusion::halved_intrinsics(intrinsics_, shift)).labels;
   if (shift == 0) return coarse;
   // Every full-resolution pixel takes the label of the coarse pixel covering it.
-  if (frame_labels_.width() != depth_m.width() || frame_labels_.height() != depth_m.height())
-    frame_labels_ = Image<std::int32_t>(depth_m.width(), depth_m.height(), 1);
+  frame_labels_.ensure_size(depth_m.width(), depth_m.height(), 1);
   parallel_for(std::size_t(depth_m.height()), [&](std::size_t row) {
     const int y = std::min(int(row) >> shift, depth.height() - 1);
     std::int32_t* out = frame_labels_.plane(0) + row * depth_m.width();
