@@ -63,8 +63,9 @@ reflectance::HemiDataset read_dataset(const std::string& folder, StageTimings& t
   reflectance::HemiDataset data = reflectance::read_hemi_dataset(folder);
   std::size_t images = 0;
   for (const auto& sequence : data.sequences) images += sequence.images;
-  log().info("{}: {} sequences, {} hemi-images of {}x{} ({})", folder, data.sequences.size(),
-             images, data.size, data.size, reflectance::hemi_projection_name(data.projection));
+  log().info("{}: {} sequences, {} hemi-images of {}x{} ({}, {})", folder, data.sequences.size(),
+             images, data.size, data.size, reflectance::hemi_projection_name(data.projection),
+             reflectance::hemi_input_name(data.input));
   return data;
 }
 
@@ -75,6 +76,7 @@ void run_train(const TrainOptions& options) {
   reflectance::HemiCnnConfig config;
   config.image_size = data.size;
   config.projection = data.projection;
+  config.input = data.input;
   log().info("network with {} trainable parameters; {} batches of {} sets of {}",
              reflectance::HemiCnn(config).parameter_count(), options.params.batches,
              options.params.batch_size, options.params.set_size);
@@ -153,13 +155,16 @@ void run_predict(const PredictOptions& options) {
   StageTimings timings;
   const reflectance::HemiCnn model = reflectance::HemiCnn::load(options.model);
   const reflectance::HemiDataset data = read_dataset(options.dataset, timings);
-  if (data.projection != model.projection() || data.size != model.image_size())
-    throw Error(
-        options.dataset, "projection",
-        fmt::format("holds {} {}x{} hemi-images; the model {} was trained on {} {}x{}",
-                    reflectance::hemi_projection_name(data.projection), data.size, data.size,
-                    options.model, reflectance::hemi_projection_name(model.projection()),
-                    model.image_size(), model.image_size()));
+  if (data.projection != model.projection() || data.input != model.input() ||
+      data.size != model.image_size())
+    throw Error(options.dataset, "projection",
+                fmt::format("holds {} {} {}x{} hemi-images; the model {} was trained on {} {} "
+                            "{}x{}",
+                            reflectance::hemi_projection_name(data.projection),
+                            reflectance::hemi_input_name(data.input), data.size, data.size,
+                            options.model, reflectance::hemi_projection_name(model.projection()),
+                            reflectance::hemi_input_name(model.input()), model.image_size(),
+                            model.image_size()));
   const int sequence_count = static_cast<int>(data.sequences.size());
   const int evaluated =
       std::clamp(static_cast<int>(std::lround(options.validation_fraction * sequence_count)), 1,
@@ -246,7 +251,8 @@ void register_hemicnn_train(CLI::App& hemicnn) {
       "train", "Train the HemiCNN on a hemi-image dataset and write a model file (JSON)");
   command->footer(fmt::format(
       "DATASET: a folder made by 'glint hemicnn dataset' (index.json + seq_*.npy); its\n"
-      "projection (parabolic or orthographic) is stored in the model.\n"
+      "projection (parabolic or orthographic) and input (radiance or reflectance) are stored\n"
+      "in the model, and the pipeline makes its hemi-images the same way.\n"
       "Training (paper 1 §3.6, §4.1): each example is 25 random hemi-images of one random\n"
       "training sequence; loss eq. (5) with Lab in units of 100; Adam lr {}, batches of {};\n"
       "the last {} % of the sequences are held out and the weights with the lowest validation\n"
@@ -254,9 +260,12 @@ void register_hemicnn_train(CLI::App& hemicnn) {
       "8-10 minutes on one CPU core (44-55 batches/s measured; see --torch-threads).\n"
       "Examples:\n"
       "  # the modified HemiCNN (paper 1: lambda_d 0.1, lambda_l 0.3, parabolic hemi-images)\n"
-      "  glint hemicnn train hemi/parabolic -o models/hemicnn.json --report train.json\n"
+      "  glint hemicnn train hemi/parabolic-reflectance -o models/hemicnn.json --report t.json\n"
       "  # the unmodified HemiCNN of Kim et al. (lambda_d = lambda_l = 1, orthographic)\n"
-      "  glint hemicnn train hemi/orthographic --lambda-d 1 --lambda-l 1 -o hemicnn-kim.json",
+      "  glint hemicnn train hemi/orthographic-reflectance --lambda-d 1 --lambda-l 1 \\\n"
+      "    -o models/hemicnn-unmodified.json\n"
+      "  # either on radiance hemi-images, paper 1's input (scripts/train-hemicnn.sh)\n"
+      "  glint hemicnn train hemi/parabolic -o models/hemicnn-radiance.json",
       defaults.learning_rate, defaults.batch_size, 100 * defaults.validation_fraction,
       defaults.batches));
   command->add_option("DATASET", options->dataset, "Hemi-image dataset folder")->required();
@@ -319,10 +328,11 @@ void register_hemicnn_predict(CLI::App& hemicnn) {
       "From each of the last --validation fraction of the sequences (the split 'glint hemicnn\n"
       "train' held out with the same fraction) --sets random sets of 25 hemi-images are drawn;\n"
       "the model's prediction is converted back to Ward parameters (kd, ks, alpha) and compared\n"
-      "with the ground truth. The dataset's projection must be the model's.\n"
+      "with the ground truth. The dataset's projection and input must be the model's.\n"
       "Example (modified vs unmodified HemiCNN):\n"
-      "  glint hemicnn predict hemi/parabolic --model models/hemicnn.json --report ours.json\n"
-      "  glint hemicnn predict hemi/orthographic --model hemicnn-kim.json --report kim.json");
+      "  glint hemicnn predict hemi/parabolic-reflectance --model models/hemicnn.json\n"
+      "  glint hemicnn predict hemi/orthographic-reflectance \\\n"
+      "    --model models/hemicnn-unmodified.json");
   command->add_option("DATASET", options->dataset, "Hemi-image dataset folder")->required();
   command->add_option("--model", options->model, "HemiCNN model file (.json)")->required();
   command

@@ -22,6 +22,7 @@ struct DatasetOptions {
   std::string training_set;
   std::string output;
   std::string projection = "both";
+  std::string input = "both";
   int max_sequences = 0;
   reflectance::HemiExtractionParams params;
 };
@@ -43,25 +44,28 @@ void run_dataset(const DatasetOptions& options) {
   std::vector<std::string> folders = sequence_folders(options.training_set);
   if (options.max_sequences > 0 && std::size_t(options.max_sequences) < folders.size())
     folders.resize(options.max_sequences);
-  std::vector<reflectance::HemiProjection> projections;
-  if (options.projection == "both")
-    projections = {reflectance::HemiProjection::parabolic,
-                   reflectance::HemiProjection::orthographic};
-  else
-    projections = {reflectance::parse_hemi_projection(options.projection, "--projection")};
+  std::vector<reflectance::HemiImageKind> kinds;
+  for (const std::string projection : {"parabolic", "orthographic"})
+    for (const std::string input : {"radiance", "reflectance"})
+      if ((options.projection == "both" || options.projection == projection) &&
+          (options.input == "both" || options.input == input))
+        kinds.push_back({reflectance::parse_hemi_projection(projection, "--projection"),
+                         reflectance::parse_hemi_input(input, "--input")});
   std::vector<reflectance::HemiDatasetWriter> writers;
-  for (reflectance::HemiProjection projection : projections)
+  for (const reflectance::HemiImageKind& kind : kinds) {
+    const std::string folder =
+        std::string(reflectance::hemi_projection_name(kind.projection)) +
+        (kind.input == reflectance::HemiInput::reflectance ? "-reflectance" : "");
     writers.emplace_back(
-        projections.size() == 1
-            ? options.output
-            : (fs::path(options.output) / reflectance::hemi_projection_name(projection)).string(),
-        15, projection);
+        kinds.size() == 1 ? options.output : (fs::path(options.output) / folder).string(), 15,
+        kind.projection, kind.input);
+  }
 
   int skipped = 0;
   ProgressBar progress("hemi-images", folders.size());
   for (const std::string& folder : folders) {
     const reflectance::ExtractedHemiImages extracted =
-        reflectance::extract_hemi_images(folder, projections, options.params);
+        reflectance::extract_hemi_images(folder, kinds, options.params);
     progress.advance();
     if (extracted.count < reflectance::kMinHemiImages) {
       log().warn("{}: only {} voxels with {} observations; skipped", folder, extracted.count,
@@ -69,8 +73,8 @@ void run_dataset(const DatasetOptions& options) {
       ++skipped;
       continue;
     }
-    for (std::size_t p = 0; p < projections.size(); ++p)
-      writers[p].add_sequence(extracted.images[p].data(), extracted.count, extracted.material,
+    for (std::size_t k = 0; k < kinds.size(); ++k)
+      writers[k].add_sequence(extracted.images[k].data(), extracted.count, extracted.material,
                               folder);
   }
   progress.finish();
@@ -88,13 +92,19 @@ void register_hemicnn_dataset(CLI::App& hemicnn) {
       "Turn a rendered training set (glint synth training) into HemiCNN training data: each\n"
       "sequence runs through the pipeline's geometry fusion (true poses) and observation\n"
       "collection (true segmentation), and up to --max-images voxels of its object become\n"
-      "15x15 hemi-images (paper 1 §4.1). With --projection both (default) OUT/parabolic and\n"
-      "OUT/orthographic are written, for the modified and the unmodified HemiCNN.");
+      "15x15 hemi-images (paper 1 §4.1), of radiance (the paper's input) or of reflectance\n"
+      "(radiance times pi over the true lights' irradiance at the voxel, the default model's\n"
+      "input). With more than one kind, each goes to its own folder: OUT/parabolic and\n"
+      "OUT/orthographic (radiance, for the paper's modified and unmodified HemiCNN),\n"
+      "OUT/parabolic-reflectance and OUT/orthographic-reflectance.");
   command->add_option("training_set", options->training_set, "Folder of seq_* sequences")
       ->required();
   command->add_option("-o,--output", options->output, "Dataset folder")->required();
   command->add_option("--projection", options->projection, "parabolic, orthographic or both")
       ->check(CLI::IsMember({"parabolic", "orthographic", "both"}))
+      ->capture_default_str();
+  command->add_option("--input", options->input, "radiance, reflectance or both")
+      ->check(CLI::IsMember({"radiance", "reflectance", "both"}))
       ->capture_default_str();
   command
       ->add_option("--obs-voxel", options->params.observations.voxel_size_m,
@@ -110,7 +120,7 @@ void register_hemicnn_dataset(CLI::App& hemicnn) {
       "Example:\n"
       "  glint synth training -o train --sequences 400\n"
       "  glint hemicnn dataset train -o hemi\n"
-      "  glint hemicnn train hemi/parabolic -o models/hemicnn.json");
+      "  glint hemicnn train hemi/parabolic-reflectance -o models/hemicnn.json");
   command->callback([options] { run_dataset(*options); });
 }
 

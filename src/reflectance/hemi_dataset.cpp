@@ -86,6 +86,16 @@ HemiProjection parse_hemi_projection(const std::string& name, const std::string&
               fmt::format("unknown projection \"{}\" (parabolic or orthographic)", name));
 }
 
+const char* hemi_input_name(HemiInput input) {
+  return input == HemiInput::radiance ? "radiance" : "reflectance";
+}
+
+HemiInput parse_hemi_input(const std::string& name, const std::string& where) {
+  if (name == "radiance") return HemiInput::radiance;
+  if (name == "reflectance") return HemiInput::reflectance;
+  throw Error(where, "input", fmt::format("unknown input \"{}\" (radiance or reflectance)", name));
+}
+
 HemiDataset read_hemi_dataset(const std::string& directory) {
   const std::filesystem::path folder(directory);
   const std::string index_path = (folder / "index.json").string();
@@ -101,6 +111,8 @@ HemiDataset read_hemi_dataset(const std::string& directory) {
   dataset.size = size.get<int>();
   check_size(dataset.size, index_path);
   dataset.projection = parse_hemi_projection(reader.string(root, "projection", ""), index_path);
+  if (root.contains("input"))
+    dataset.input = parse_hemi_input(reader.string(root, "input", ""), index_path);
 
   const nlohmann::json& entries = reader.member(root, "sequences", "");
   if (!entries.is_array()) reader.fail("sequences", "expected an array");
@@ -133,8 +145,9 @@ HemiDataset read_hemi_dataset(const std::string& directory) {
   return dataset;
 }
 
-HemiDatasetWriter::HemiDatasetWriter(std::string directory, int size, HemiProjection projection)
-    : directory_(std::move(directory)), size_(size), projection_(projection) {
+HemiDatasetWriter::HemiDatasetWriter(std::string directory, int size, HemiProjection projection,
+                                     HemiInput input)
+    : directory_(std::move(directory)), size_(size), projection_(projection), input_(input) {
   check_size(size, directory_);
   std::error_code error;
   std::filesystem::create_directories(directory_, error);
@@ -184,6 +197,7 @@ void HemiDatasetWriter::finish() {
                   {"version", kFormatVersion},
                   {"size", size_},
                   {"projection", hemi_projection_name(projection_)},
+                  {"input", hemi_input_name(input_)},
                   {"sequences", sequences}});
 }
 

@@ -4,13 +4,15 @@
 //
 //   DIR/index.json      {"format": "glint-hemi-dataset", "version": 1, "size": 15,
 //                        "projection": "parabolic" | "orthographic",
+//                        "input": "radiance" | "reflectance" (HemiInput; absent: radiance),
 //                        "sequences": [{"file": "seq_00000.npy",
 //                                       "target": [L, a, b, c_r, c_g, c_b, d],
 //                                       "kd": [r, g, b], "ks": [r, g, b], "alpha": a,
 //                                       "source": "the rendered sequence it came from"}, ...]}
 //   DIR/seq_XXXXX.npy   float32 [M, 3, size, size], kMinHemiImages <= M <= kMaxHemiImages:
 //                       M hemi-images of one object, each channel-major (CHW, as
-//                       make_hemi_image writes them), linear radiance (pixel / exposure).
+//                       make_hemi_image writes them), linear radiance (pixel / exposure) or,
+//                       for "reflectance", radiance times the voxel's reflectance_scale.
 // "target" is render::to_perceptual of (kd, ks, alpha): the regression target of eq. (5).
 // Memory: a read dataset holds every image, M * 3 * size^2 * 4 bytes per sequence
 // (1.35 MB for M = 500, size 15).
@@ -30,6 +32,9 @@ inline constexpr int kMaxHemiImages = 500;  // the paper's hemi-images per seque
 // "parabolic" / "orthographic" and back; an unknown name -> glint::Error(where, "projection").
 const char* hemi_projection_name(HemiProjection projection);
 HemiProjection parse_hemi_projection(const std::string& name, const std::string& where);
+// "radiance" / "reflectance" and back; an unknown name -> glint::Error(where, "input").
+const char* hemi_input_name(HemiInput input);
+HemiInput parse_hemi_input(const std::string& name, const std::string& where);
 
 struct HemiSequence {
   std::string file;    // npy file name inside the dataset folder
@@ -48,6 +53,7 @@ struct HemiDataset {
   std::string directory;
   int size = 15;  // pixels per hemi-image side
   HemiProjection projection = HemiProjection::parabolic;
+  HemiInput input = HemiInput::radiance;
   std::vector<HemiSequence> sequences;
 };
 
@@ -65,7 +71,8 @@ class HemiDatasetWriter {
   // Creates the folder (and parents). Throws glint::Error for a size out of range or when the
   // folder cannot be created.
   explicit HemiDatasetWriter(std::string directory, int size = 15,
-                             HemiProjection projection = HemiProjection::parabolic);
+                             HemiProjection projection = HemiProjection::parabolic,
+                             HemiInput input = HemiInput::radiance);
 
   // Writes `count` images (count x 3 x size x size floats, CHW each) of one object as the next
   // seq_XXXXX.npy and returns its index. Throws glint::Error for a count outside
@@ -82,6 +89,7 @@ class HemiDatasetWriter {
   std::string directory_;
   int size_;
   HemiProjection projection_;
+  HemiInput input_;
   std::vector<HemiSequence> entries_;  // without values
 };
 

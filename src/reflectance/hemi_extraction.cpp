@@ -14,7 +14,7 @@
 namespace glint::reflectance {
 
 ExtractedHemiImages extract_hemi_images(const std::string& sequence_folder,
-                                        const std::vector<HemiProjection>& projections,
+                                        const std::vector<HemiImageKind>& kinds,
                                         const HemiExtractionParams& params) {
   const io::RgbdSequence sequence = io::open_rgbd_sequence(sequence_folder);
   if (!has_ground_truth_maps(sequence) || !sequence.has_ground_truth())
@@ -55,14 +55,18 @@ ExtractedHemiImages extract_hemi_images(const std::string& sequence_folder,
   ExtractedHemiImages result;
   result.material = object->material.ward;
   result.count = int(voxels.size());
-  for (HemiProjection projection : projections) {
+  for (const HemiImageKind& kind : kinds) {
     HemiImageParams hemi;
-    hemi.projection = projection;
+    hemi.projection = kind.projection;
     const std::size_t floats = std::size_t(3) * hemi.size * hemi.size;
     std::vector<float>& images = result.images.emplace_back(voxels.size() * floats);
-    for (std::size_t k = 0; k < voxels.size(); ++k)
-      make_hemi_image(grid.observations(voxels[k]), grid.observation_count(voxels[k]),
-                      grid.normal(voxels[k]), hemi, images.data() + k * floats);
+    for (std::size_t k = 0; k < voxels.size(); ++k) {
+      const int v = voxels[k];
+      const Eigen::Vector3f scale =
+          hemi_input_scale(kind.input, scene.lights, grid.position(v), grid.normal(v));
+      make_hemi_image(grid.observations(v), grid.observation_count(v), grid.normal(v), hemi,
+                      images.data() + k * floats, scale);
+    }
   }
   return result;
 }

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "reflectance/light_incidence.h"
 
 namespace glint::reflectance {
 
@@ -32,8 +33,14 @@ Eigen::Vector2f project_to_disk(const Eigen::Vector3f& d, HemiProjection project
   return {d.x() * scale, d.y() * scale};
 }
 
+Eigen::Vector3f hemi_input_scale(HemiInput input, const std::vector<render::PointLight>& lights,
+                                 const Eigen::Vector3f& position, const Eigen::Vector3f& normal) {
+  return input == HemiInput::radiance ? Eigen::Vector3f::Ones()
+                                      : reflectance_scale(lights, position, normal);
+}
+
 void make_hemi_image(const Observation* observations, int count, const Eigen::Vector3f& normal,
-                     const HemiImageParams& params, float* out) {
+                     const HemiImageParams& params, float* out, const Eigen::Vector3f& scale) {
   const int size = params.size;
   const int pixels = size * size;
   if (size < kMinHemiImageSize || size > kMaxHemiImageSize)
@@ -85,7 +92,7 @@ void make_hemi_image(const Observation* observations, int count, const Eigen::Ve
       const Eigen::Vector3f colour = nearest_index < 0
                                          ? Eigen::Vector3f::Zero()
                                          : observations[source[nearest_index]].colour();
-      for (int c = 0; c < 3; ++c) out[c * pixels + y * size + x] = colour[c];
+      for (int c = 0; c < 3; ++c) out[c * pixels + y * size + x] = colour[c] * scale[c];
     }
   }
 }

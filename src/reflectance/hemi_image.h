@@ -6,12 +6,21 @@
 //  - parabolic (paper 1, default): u = x / (1 + z), v = y / (1 + z) (keeps flat angles apart)
 //  - orthographic (Kim et al. 2017, the unmodified HemiCNN): u = x, v = y
 #include <Eigen/Core>
+#include <vector>
 
 #include "reflectance/observation.h"
+#include "render/scene.h"
 
 namespace glint::reflectance {
 
 enum class HemiProjection { parabolic, orthographic };
+
+// What a hemi-image's pixels hold:
+//  - radiance (paper 1): the observed linear radiance; the network must guess the lighting
+//  - reflectance (glint's): radiance times reflectance_scale (reflectance/light_incidence.h),
+//    pi over the point lights' irradiance at the voxel, so that a Lambertian surface shows its
+//    albedo kd in every pixel whatever the lights, and a lobe rises above it
+enum class HemiInput { radiance, reflectance };
 
 // Hemi-image sizes glint supports (pixels per side).
 inline constexpr int kMinHemiImageSize = 3, kMaxHemiImageSize = 64;
@@ -28,10 +37,17 @@ Eigen::Matrix3f local_frame(const Eigen::Vector3f& normal);
 // Disk coordinates (u, v) in [-1, 1]^2 of a local direction with z >= 0.
 Eigen::Vector2f project_to_disk(const Eigen::Vector3f& local_direction, HemiProjection projection);
 
-// Writes size*size*3 floats, channel-major (CHW) like the network's input, into `out`.
+// The per-channel scale of a voxel's hemi-image for `input`: one for radiance,
+// reflectance_scale(lights, position, normal) (reflectance/light_incidence.h) for reflectance.
+Eigen::Vector3f hemi_input_scale(HemiInput input, const std::vector<render::PointLight>& lights,
+                                 const Eigen::Vector3f& position, const Eigen::Vector3f& normal);
+
+// Writes size*size*3 floats, channel-major (CHW) like the network's input, into `out`: each
+// pixel the colour of its nearest observation times `scale` per channel (HemiInput).
 // Observations below the surface (direction . normal <= 0) are ignored; with none left the
 // image is black. At most the first 256 observations are used. No allocation.
 void make_hemi_image(const Observation* observations, int count, const Eigen::Vector3f& normal,
-                     const HemiImageParams& params, float* out);
+                     const HemiImageParams& params, float* out,
+                     const Eigen::Vector3f& scale = Eigen::Vector3f::Ones());
 
 }  // namespace glint::reflectance

@@ -322,13 +322,14 @@ nlohmann::json HemiCnn::to_json() const {
       {"version", kFormatVersion},
       {"image_size", config.image_size},
       {"projection", hemi_projection_name(config.projection)},
+      {"input", hemi_input_name(config.input)},
       {"conv_channels", config.conv_channels},
       {"branch_features", config.branch_features},
       {"head_hidden", config.head_hidden},
       {"leaky_slope", io::exact_float(config.leaky_slope)},
       {"weight_layout", "conv [ky][kx][in][out], dense [in][out]; flatten order (y, x, channel)"},
       {"parameter_count", parameter_count()},
-      {"input_transform", "log1p(max(radiance, 0))"},
+      {"input_transform", "log1p(max(input, 0))"},
       {"input_mean", io::exact_float_array(input_mean, 3)},
       {"input_std", io::exact_float_array(input_std, 3)},
       {"targets", kTargetNames},
@@ -349,6 +350,8 @@ HemiCnn HemiCnn::load(const std::string& path) {
   const nlohmann::json& projection = reader.member(root, "projection", "");
   if (!projection.is_string()) reader.fail("projection", "expected a string");
   config.projection = parse_hemi_projection(projection.get<std::string>(), path);
+  if (root.contains("input"))  // model files before HemiInput hold radiance models
+    config.input = parse_hemi_input(reader.string(root, "input"), path);
   const nlohmann::json& channels = reader.member(root, "conv_channels", "");
   if (!channels.is_array()) reader.fail("conv_channels", "expected an array of integers");
   config.conv_channels.clear();

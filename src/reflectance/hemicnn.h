@@ -4,7 +4,8 @@
 // (render/perceptual.h). Definition, fast plain-C++ inference and the JSON model file;
 // training (libtorch) lives in reflectance/hemicnn_train.h.
 //
-// Network, for `count` (normally 25) hemi-images of 3 x S x S (S = 15) linear radiances each:
+// Network, for `count` (normally 25) hemi-images of 3 x S x S (S = 15) linear radiances (or
+// reflectances, config.input) each:
 //   input         x' = (log1p(x) - input_mean[c]) / input_std[c] per channel c, x clamped to
 //                 [0, 1e30] (NaN counts as 0): log1p compresses highlights but keeps absolute
 //                 scale (kd is absolute); the fixed per-channel standardisation comes from the
@@ -36,6 +37,7 @@ namespace glint::reflectance {
 struct HemiCnnConfig {
   int image_size = 15;  // S: hemi-image pixels per side (HemiImageParams::size)
   HemiProjection projection = HemiProjection::parabolic;  // of the hemi-images it was trained on
+  HemiInput input = HemiInput::radiance;                  // likewise
   std::vector<int> conv_channels{16, 32, 32};             // outputs of each 3x3 convolution
   int branch_features = 128;  // per-branch feature vector, averaged over the branches
   int head_hidden = 64;
@@ -82,6 +84,7 @@ class HemiCnn {
   nlohmann::json training_info = nlohmann::json::object();  // free-form: how it was trained
 
   HemiProjection projection() const { return config.projection; }
+  HemiInput input() const { return config.input; }
   int image_size() const { return config.image_size; }
   // Floats of one input hemi-image: 3 * image_size^2.
   std::size_t image_floats() const;

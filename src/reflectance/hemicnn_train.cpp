@@ -288,6 +288,7 @@ HemiCnn train_hemicnn(const HemiDataset& data, HemiCnnConfig config,
   check_params(params);
   config.image_size = data.size;
   config.projection = data.projection;
+  config.input = data.input;
   HemiCnn model(config);
   const std::string where = data.directory.empty() ? "HemiCNN training data" : data.directory;
   const int sequence_count = static_cast<int>(data.sequences.size());

@@ -1,9 +1,13 @@
 #pragma once
 // How a near-field point light reaches a surface point (paper 1 eq. (6)): the unit direction to
 // the light and L_l cos(theta_i) = intensity cos(theta_i) / r^2, zero when the light is behind
-// the surface. Shared by the albedo refinement and the specular lobe fit.
+// the surface. Shared by the albedo refinement, the specular lobe fit and the HemiCNN's
+// reflectance input.
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
+#include <numbers>
+#include <vector>
 
 #include "render/scene.h"
 
@@ -24,6 +28,32 @@ inline Incidence incidence(const render::PointLight& light, const Eigen::Vector3
   const float cos_i = normal.dot(wi);
   if (cos_i <= 0.0f) return {wi, Eigen::Vector3f::Zero(), 0.0f};
   return {wi, light.intensity * (cos_i / distance2), cos_i};
+}
+
+// The irradiance share below which reflectance_scale floors a point's irradiance: a tenth of
+// what its lights would give it head-on (cos 84 deg), so that grazing and back-lit points'
+// radiances are amplified at most tenfold over a head-on lit one's.
+inline constexpr float kMinIrradianceShare = 0.1f;
+
+// pi / E per channel, E = sum_l L_l cos(theta_i,l) the lights' irradiance at a surface point
+// (unshadowed), floored at kMinIrradianceShare of sum_l L_l: radiance times this is the
+// point's apparent reflectance, where a Lambertian surface shows its albedo kd (eq. (6) with
+// ks = 0) whatever the lights. 0 in a channel no light emits.
+inline Eigen::Vector3f reflectance_scale(const std::vector<render::PointLight>& lights,
+                                         const Eigen::Vector3f& position,
+                                         const Eigen::Vector3f& normal) {
+  Eigen::Vector3f irradiance = Eigen::Vector3f::Zero(), head_on = Eigen::Vector3f::Zero();
+  for (const render::PointLight& light : lights) {
+    irradiance += incidence(light, position, normal).irradiance;
+    const float distance2 = (light.position.cast<float>() - position).squaredNorm();
+    if (distance2 > 0.0f) head_on += light.intensity / distance2;
+  }
+  Eigen::Vector3f scale;
+  for (int c = 0; c < 3; ++c) {
+    const float floored = std::max(irradiance[c], kMinIrradianceShare * head_on[c]);
+    scale[c] = floored > 0.0f ? std::numbers::pi_v<float> / floored : 0.0f;
+  }
+  return scale;
 }
 
 }  // namespace glint::reflectance

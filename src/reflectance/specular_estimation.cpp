@@ -83,9 +83,13 @@ void SpecularEstimator::update(const ObservationGrid& grid, const SegmentMap& se
     }
     for (int k = sampled; k < count; ++k) voxels[std::size_t(k)] = voxels[std::size_t(k % sampled)];
     std::vector<float> images(std::size_t(count) * image_floats);
-    for (int k = 0; k < count; ++k)
-      make_hemi_image(grid.observations(voxels[k]), grid.observation_count(voxels[k]),
-                      grid.normal(voxels[k]), hemi_, images.data() + std::size_t(k) * image_floats);
+    for (int k = 0; k < count; ++k) {
+      const int v = voxels[k];
+      const Eigen::Vector3f scale =
+          hemi_input_scale(network_.input(), lights, grid.position(v), grid.normal(v));
+      make_hemi_image(grid.observations(v), grid.observation_count(v), grid.normal(v), hemi_,
+                      images.data() + std::size_t(k) * image_floats, scale);
+    }
     estimates[i] = render::from_perceptual(network_.predict(images.data(), count));
     if (!params_.fit_lobe) return;
     std::vector<FitVoxel> fit_voxels(count);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "reflectance/light_incidence.h"
 
 namespace glint::reflectance {
 namespace {
@@ -64,6 +65,53 @@ TEST(HemiImage, NoObservationsGiveABlackImage) {
   std::vector<float> image(3 * 15 * 15, -1.0f);
   make_hemi_image(nullptr, 0, Eigen::Vector3f::UnitZ(), {}, image.data());
   for (float v : image) EXPECT_EQ(v, 0.0f);
+}
+
+TEST(HemiImage, ReflectanceInputShowsALambertianSurfacesAlbedoWhateverTheLights) {
+  // A Lambertian point (normal +y) under two coloured lights: its radiance is kd / pi times
+  // sum_l I_l cos / r^2 (eq. (6), ks = 0) in every direction, so its reflectance is kd.
+  const Eigen::Vector3f position(0.2f, 0.0f, -0.1f), normal = Eigen::Vector3f::UnitY();
+  const Eigen::Vector3f kd(0.6f, 0.3f, 0.1f);
+  std::vector<render::PointLight> lights(2);
+  lights[0].position = {0.2, 2.0, -0.1};  // straight above, 2 m
+  lights[0].intensity = {8, 6, 4};
+  lights[1].position = {1.7, 1.5, -0.1};  // 45 degrees
+  lights[1].intensity = {3, 3, 9};
+  const Eigen::Vector3f irradiance =
+      lights[0].intensity / 4.0f + lights[1].intensity * (std::sqrt(0.5f) / 4.5f);
+  const Eigen::Vector3f radiance = kd.cwiseProduct(irradiance) / float(M_PI);
+  std::vector<Observation> obs;
+  for (const Eigen::Vector3f& d : {Eigen::Vector3f(0, 1, 0), Eigen::Vector3f(1, 1, 0).normalized(),
+                                   Eigen::Vector3f(0, 1, -2).normalized()})
+    obs.push_back({radiance, d, 0});
+  std::vector<float> image(3 * 15 * 15);
+  make_hemi_image(obs.data(), int(obs.size()), normal, {}, image.data(),
+                  hemi_input_scale(HemiInput::reflectance, lights, position, normal));
+  for (int c = 0; c < 3; ++c)
+    for (int p = 0; p < 225; ++p) EXPECT_NEAR(image[c * 225 + p], kd[c], 1e-3f * kd[c]);
+
+  // Radiance input leaves the colours as they are, bit for bit.
+  std::vector<float> plain(image.size()), radiance_input(image.size());
+  make_hemi_image(obs.data(), int(obs.size()), normal, {}, plain.data());
+  make_hemi_image(obs.data(), int(obs.size()), normal, {}, radiance_input.data(),
+                  hemi_input_scale(HemiInput::radiance, lights, position, normal));
+  EXPECT_EQ(plain, radiance_input);
+}
+
+TEST(HemiImage, ReflectanceScaleFloorsGrazingAndBackLitIrradiance) {
+  const Eigen::Vector3f position = Eigen::Vector3f::Zero(), normal = Eigen::Vector3f::UnitY();
+  std::vector<render::PointLight> lights(1);
+  lights[0].intensity = {4, 4, 0};  // no blue at all
+  lights[0].position = {0, -2, 0};  // behind the surface
+  const Eigen::Vector3f floored(float(M_PI) / (kMinIrradianceShare * 1.0f),
+                                float(M_PI) / (kMinIrradianceShare * 1.0f), 0.0f);
+  EXPECT_TRUE(reflectance_scale(lights, position, normal).isApprox(floored, 1e-6f));
+  lights[0].position = {2, 0.02, 0};  // grazing: cos 0.01 is under the floor
+  EXPECT_TRUE(reflectance_scale(lights, position, normal).isApprox(floored, 1e-3f));
+  lights[0].position = {0, 2, 0};  // head-on: pi / (I / r^2)
+  EXPECT_TRUE(reflectance_scale(lights, position, normal)
+                  .isApprox(Eigen::Vector3f(float(M_PI), float(M_PI), 0.0f), 1e-6f));
+  EXPECT_TRUE(reflectance_scale({}, position, normal).isZero());
 }
 
 }  // namespace

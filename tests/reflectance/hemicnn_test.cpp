@@ -176,12 +176,14 @@ TEST(HemiCnn, ModelFileRoundTrip) {
   const TempDir dir;
   HemiCnnConfig config;
   config.projection = HemiProjection::orthographic;
+  config.input = HemiInput::reflectance;
   HemiCnn model = random_model(config, 7);
   model.training_info = {{"note", "test"}};
   model.save(dir.file("model.json"));
   EXPECT_LT(std::filesystem::file_size(dir.file("model.json")), 1000000u);
   const HemiCnn loaded = HemiCnn::load(dir.file("model.json"));
   EXPECT_EQ(loaded.projection(), HemiProjection::orthographic);
+  EXPECT_EQ(loaded.input(), HemiInput::reflectance);
   EXPECT_EQ(loaded.config.conv_channels, config.conv_channels);
   ASSERT_EQ(loaded.layers.size(), model.layers.size());
   for (std::size_t l = 0; l < model.layers.size(); ++l) {
@@ -193,6 +195,17 @@ TEST(HemiCnn, ModelFileRoundTrip) {
   EXPECT_EQ(loaded.training_info["note"], "test");
   const std::vector<float> images = random_images(25, 15, 8);
   EXPECT_EQ(raw_outputs(loaded, images.data(), 25), raw_outputs(model, images.data(), 25));
+}
+
+TEST(HemiCnn, AModelFileWithoutAnInputHoldsARadianceModel) {
+  // Model files written before HemiInput existed have no "input".
+  const TempDir dir;
+  HemiCnnConfig config;
+  config.input = HemiInput::reflectance;
+  nlohmann::json old_file = random_model(config, 3).to_json();
+  old_file.erase("input");
+  io::write_json(dir.file("old.json"), old_file);
+  EXPECT_EQ(HemiCnn::load(dir.file("old.json")).input(), HemiInput::radiance);
 }
 
 TEST(HemiCnn, LoadNamesTheBadKey) {
@@ -212,6 +225,7 @@ TEST(HemiCnn, LoadNamesTheBadKey) {
   EXPECT_EQ(element_of_error([](nlohmann::json& j) { j.erase("target_std"); }), "target_std");
   EXPECT_EQ(element_of_error([](nlohmann::json& j) { j["input_std"][1] = 0.0; }), "input_std[1]");
   EXPECT_EQ(element_of_error([](nlohmann::json& j) { j["projection"] = "fisheye"; }), "projection");
+  EXPECT_EQ(element_of_error([](nlohmann::json& j) { j["input"] = "irradiance"; }), "input");
   EXPECT_EQ(element_of_error([](nlohmann::json& j) { j["conv_channels"] = {16, 32}; }), "layers");
   EXPECT_EQ(element_of_error([](nlohmann::json& j) { j["layers"][2]["weights"].erase(0); }),
             "layers[2].weights");
@@ -273,7 +287,8 @@ void write_dataset(const std::string& folder, int sequences, int images_per_sequ
 TEST(HemiDataset, RoundTrip) {
   const TempDir dir;
   std::mt19937_64 rng(1);
-  HemiDatasetWriter writer(dir.file("set"), 15, HemiProjection::orthographic);
+  HemiDatasetWriter writer(dir.file("set"), 15, HemiProjection::orthographic,
+                           HemiInput::reflectance);
   const render::WardMaterial m0 = material_of(rng), m1 = material_of(rng);
   const std::vector<float> images0 = diffuse_images(m0, 25, rng),
                            images1 = diffuse_images(m1, 40, rng);
@@ -284,6 +299,7 @@ TEST(HemiDataset, RoundTrip) {
   const HemiDataset data = read_hemi_dataset(dir.file("set"));
   EXPECT_EQ(data.size, 15);
   EXPECT_EQ(data.projection, HemiProjection::orthographic);
+  EXPECT_EQ(data.input, HemiInput::reflectance);
   ASSERT_EQ(data.sequences.size(), 2u);
   EXPECT_EQ(data.sequences[0].file, "seq_00000.npy");
   EXPECT_EQ(data.sequences[1].source, "second");
@@ -323,6 +339,13 @@ TEST(HemiDataset, RejectsBadInputsNamingTheFile) {
     changed["size"] = 2;
     io::write_json(index, changed);
     EXPECT_EQ(fails_on(index).element(), "size");
+    changed = good_index;
+    changed["input"] = "irradiance";
+    io::write_json(index, changed);
+    EXPECT_EQ(fails_on(index).element(), "input");
+    changed.erase("input");  // datasets written before HemiInput hold radiance
+    io::write_json(index, changed);
+    EXPECT_EQ(read_hemi_dataset(folder).input, HemiInput::radiance);
     changed = good_index;
     changed["sequences"][1]["target"][6] = 0.5;
     io::write_json(index, changed);
