@@ -8,9 +8,11 @@
 #   - with the HemiCNN's ks, alpha alone (the paper), without glint's lobe fit;
 #   - with the modified (parabolic, lambda_d 0.1, lambda_l 0.3) and the unmodified
 #     (orthographic, lambda 1) HemiCNN, ground-truth segmentation, both without the lobe fit;
+#   - the same three with the networks trained on radiance hemi-images (paper 1's input)
+#     instead of reflectance ones (glint's default: models/README.md);
 #   - at 1 cm observation voxels (Table 3 timings);
 #   - "fast": 1 cm geometry voxels instead of 5 mm (a CPU budget option, not the paper's).
-# Every 10th frame (and the last) is scored; about 9 minutes on 2 cores for the three scenes
+# Every 10th frame (and the last) is scored; about 13 minutes on 2 cores for the three scenes
 # once they are rendered.
 # Reports: OUT/<scene>-<variant>/report.json; a summary table: OUT/summary.md.
 #   scripts/eval-reflectance.sh GLINT DATA [OUT] [SCENES] [FRAMES]
@@ -46,6 +48,11 @@ for scene in $SCENES; do
     --specular hemicnn
   run unmodified --gt-segmentation --model "$MODELS/hemicnn-unmodified.json" --eval-every 10 \
     --specular hemicnn
+  run radiance --gt-segmentation --model "$MODELS/hemicnn-radiance.json" --eval-every 10
+  run hemicnn-radiance --gt-segmentation --model "$MODELS/hemicnn-radiance.json" \
+    --eval-every 10 --specular hemicnn
+  run unmodified-radiance --gt-segmentation --model "$MODELS/hemicnn-unmodified-radiance.json" \
+    --eval-every 10 --specular hemicnn
   run gtseg-1cm --gt-segmentation --model "$MODELS/hemicnn.json" --obs-voxel 0.01 --eval-every 0
   run fast --gt-segmentation --model "$MODELS/hemicnn.json" --voxel 0.01 --eval-every 0
 done

@@ -64,14 +64,15 @@ def main():
               "| paper (bunnies, own pipeline) | " +
               " | ".join(str(PAPER_AVERAGE[q][0]) for q in QUANTITIES) + " | 27.61 | |"]
     for scene in scenes:
-        for variant in ["gtseg", "ownseg", "mean-albedo", "hemicnn", "unmodified", "gtseg-1cm",
-                        "fast"]:
+        for variant in ["gtseg", "ownseg", "mean-albedo", "hemicnn", "unmodified", "radiance",
+                        "hemicnn-radiance", "unmodified-radiance", "gtseg-1cm", "fast"]:
             r = load(out, scene, variant)
             if scored(r):
                 lines.append(averages_row(r, f"{scene} / {variant}"))
     lines.append("")
     for scene in scenes:
-        for variant in ["gtseg", "ownseg", "mean-albedo", "hemicnn", "unmodified"]:
+        for variant in ["gtseg", "ownseg", "mean-albedo", "hemicnn", "unmodified", "radiance",
+                        "hemicnn-radiance", "unmodified-radiance"]:
             r = load(out, scene, variant)
             if scored(r):
                 lines += table1(r, f"{scene}, {variant}")
