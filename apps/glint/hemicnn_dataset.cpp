@@ -45,12 +45,13 @@ void run_dataset(const DatasetOptions& options) {
   if (options.max_sequences > 0 && std::size_t(options.max_sequences) < folders.size())
     folders.resize(options.max_sequences);
   std::vector<reflectance::HemiImageKind> kinds;
-  for (const std::string projection : {"parabolic", "orthographic"})
-    for (const std::string input : {"radiance", "reflectance"})
-      if ((options.projection == "both" || options.projection == projection) &&
-          (options.input == "both" || options.input == input))
-        kinds.push_back({reflectance::parse_hemi_projection(projection, "--projection"),
-                         reflectance::parse_hemi_input(input, "--input")});
+  for (auto projection :
+       {reflectance::HemiProjection::parabolic, reflectance::HemiProjection::orthographic})
+    for (auto input : {reflectance::HemiInput::radiance, reflectance::HemiInput::reflectance})
+      if ((options.projection == "both" ||
+           options.projection == reflectance::hemi_projection_name(projection)) &&
+          (options.input == "both" || options.input == reflectance::hemi_input_name(input)))
+        kinds.push_back({projection, input});
   std::vector<reflectance::HemiDatasetWriter> writers;
   for (const reflectance::HemiImageKind& kind : kinds) {
     const std::string folder =
