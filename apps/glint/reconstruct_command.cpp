@@ -23,6 +23,7 @@
 #include "io/rgbd_sequence.h"
 #include "io/trajectory.h"
 #include "reconstruct_outputs.h"
+#include "reflectance/hemi_dataset.h"
 #include "reflectance/light_estimation.h"
 #include "reflectance/material_evaluation.h"
 #include "reflectance/material_maps.h"
@@ -303,6 +304,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"segment_noise", options.params.segmentation.convexity_noise_k},
          {"exposure", options.params.exposure},
          {"model", model_path},
+         {"model_input", reflectance::hemi_input_name(network.input())},
          {"lights", lights.capture}}},
        {"timings_ms", timings.to_json()},
        {"geometry_timings_ms", pipeline.geometry_timings().to_json()},

@@ -53,6 +53,7 @@ TEST_F(ReconstructCli, WritesTheModelMaterialsLightsPicturesAndReport) {
   // --device auto: the GPU where this build has CUDA and there is one.
   EXPECT_FLOAT_EQ(report["parameters"]["albedo_smoothing"].get<float>(), 0.2f);
   EXPECT_FALSE(report["parameters"]["albedo_keep_clipped"].get<bool>());
+  EXPECT_EQ(report["parameters"]["model_input"], "radiance");  // HemiCnn's default config
   EXPECT_EQ(report["parameters"]["integration_device"],
             fusion::CudaIntegrator::available() ? "cuda" : "cpu");
   // The table is printed.
@@ -74,17 +75,22 @@ TEST_F(ReconstructCli, SaysWhichSegmentsGotNoMaterial) {
   EXPECT_NE(result.output.find("--obs-spacing 0"), std::string::npos) << result.output;
 }
 
+// Also with a model of reflectance hemi-images, which the pipeline then scales by the lights.
 TEST_F(ReconstructCli, OwnSegmentationRuns) {
-  const CommandResult result =
-      glint("reconstruct " + path("seq") + " --gt-lights --model " + path("model.json") +
-            " --gt-poses --eval-every 0 --segment-noise 1 --albedo-keep-clipped -o " + path("own") +
-            " --report " + path("own.json"));
+  reflectance::HemiCnnConfig reflectance_input;
+  reflectance_input.input = reflectance::HemiInput::reflectance;
+  reflectance::HemiCnn(reflectance_input).save(path("reflectance-model.json"));
+  const CommandResult result = glint(
+      "reconstruct " + path("seq") + " --gt-lights --model " + path("reflectance-model.json") +
+      " --gt-poses --eval-every 0 --segment-noise 1 --albedo-keep-clipped -o " + path("own") +
+      " --report " + path("own.json"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const nlohmann::json materials = io::read_json(path("own") + "/materials.json");
   EXPECT_GE(materials["segments"].size(), 1u);
   const nlohmann::json parameters = io::read_json(path("own.json"))["parameters"];
   EXPECT_FLOAT_EQ(parameters["segment_noise"].get<float>(), 1);
   EXPECT_TRUE(parameters["albedo_keep_clipped"].get<bool>());
+  EXPECT_EQ(parameters["model_input"], "reflectance");
 }
 
 // Without --gt-poses the frames are tracked. The fixture's 24 frames span the whole camera path
