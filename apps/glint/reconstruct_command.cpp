@@ -344,7 +344,9 @@ void register_reconstruct_command(CLI::App& app) {
                       "Light-capture sequence folder (low exposure, paper §3.2) or a lights.json");
   command->add_flag("--gt-lights", options->ground_truth_lights,
                     "Use the true lights of a synthetic sequence's scene.json");
-  command->add_option("--model", options->model, "HemiCNN weights (default: models/hemicnn.json)");
+  command->add_option("--model", options->model,
+                      "HemiCNN weights (default: models/hemicnn.json, on reflectance hemi-images; "
+                      "models/hemicnn-radiance.json reads radiance, as the paper)");
   command
       ->add_option("--obs-voxel", params.observations.voxel_size_m,
                    "Observation grid voxel, metres (paper: 0.02 or 0.01)")
