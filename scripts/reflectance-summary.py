@@ -21,6 +21,9 @@ METRICS = ["l1", "rmse", "psnr", "ssim", "psnr_frame", "ssim_frame", "ssim_objec
 PAPER_COLUMN = {"l1": 0, "rmse": 1, "psnr": 2, "ssim": 3, "psnr_frame": 2, "ssim_frame": 3,
                 "ssim_object": 3}
 STAGES = ["geometry", "observations", "segmentation", "specular", "albedo", "total"]
+# The variants with a per-object Table 1 (eval-reflectance.sh); the timing variants score too.
+TABLE1_VARIANTS = ["gtseg", "ownseg", "mean-albedo", "hemicnn", "unmodified", "radiance",
+                   "hemicnn-radiance", "unmodified-radiance"]
 
 
 def load(out, scene, variant):
@@ -64,15 +67,13 @@ def main():
               "| paper (bunnies, own pipeline) | " +
               " | ".join(str(PAPER_AVERAGE[q][0]) for q in QUANTITIES) + " | 27.61 | |"]
     for scene in scenes:
-        for variant in ["gtseg", "ownseg", "mean-albedo", "hemicnn", "unmodified", "radiance",
-                        "hemicnn-radiance", "unmodified-radiance", "gtseg-1cm", "fast"]:
+        for variant in TABLE1_VARIANTS + ["gtseg-1cm", "fast"]:
             r = load(out, scene, variant)
             if scored(r):
                 lines.append(averages_row(r, f"{scene} / {variant}"))
     lines.append("")
     for scene in scenes:
-        for variant in ["gtseg", "ownseg", "mean-albedo", "hemicnn", "unmodified", "radiance",
-                        "hemicnn-radiance", "unmodified-radiance"]:
+        for variant in TABLE1_VARIANTS:
             r = load(out, scene, variant)
             if scored(r):
                 lines += table1(r, f"{scene}, {variant}")

@@ -7,9 +7,10 @@
 #                                           reflectance hemi-images
 #   models/hemicnn-radiance.json            modified, on radiance hemi-images (paper 1's input)
 #   models/hemicnn-unmodified-radiance.json unmodified, on radiance hemi-images (Kim et al.)
-# Each training: 30,000 batches of 32 sets, Adam lr 1e-4, seed 1, one core. About 11 + 2 + 2 x
-# 13 minutes on 2 cores (two trainings side by side, one core each); the set and its
-# hemi-images take about 13 GB on disk, each training about 2.7 GB of memory.
+# Each training: 30,000 batches of 32 sets, Adam lr 1e-4, seed 1, one core. About 11 + 3 + 2 x
+# (8 to 13) minutes on 2 cores (rendering, hemi-images, then two pairs of trainings side by side,
+# one core each); the set and its hemi-images take about 13 GB on disk, each training about
+# 2.7 GB of memory.
 #   scripts/train-hemicnn.sh GLINT DATA [WORK]
 set -euo pipefail
 GLINT=${1:?usage: train-hemicnn.sh GLINT DATA [WORK]}

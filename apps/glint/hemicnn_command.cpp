@@ -74,9 +74,7 @@ void run_train(const TrainOptions& options) {
   StageTimings timings;
   const reflectance::HemiDataset data = read_dataset(options.dataset, timings);
   reflectance::HemiCnnConfig config;
-  config.image_size = data.size;
-  config.projection = data.projection;
-  config.input = data.input;
+  config.image_size = data.size;  // for the parameter count; training takes it from the data
   log().info("network with {} trainable parameters; {} batches of {} sets of {}",
              reflectance::HemiCnn(config).parameter_count(), options.params.batches,
              options.params.batch_size, options.params.set_size);

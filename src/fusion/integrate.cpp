@@ -95,7 +95,8 @@ namespace {
 // per register instead.
 static_assert(kBlockSide == kLaneCount);
 constexpr Floats kLanes{0, 1, 2, 3, 4, 5, 6, 7};
-constexpr int kWeightsPerLine = 64 / sizeof(std::uint8_t);
+// Pool entries per 64-byte cache line, for prefetching the next block a line at a time.
+constexpr int kFloatsPerLine = 64 / sizeof(float), kWeightsPerLine = 64 / sizeof(std::uint8_t);
 
 // Fuses kRows consecutive rows (row r's voxel centres are first[r] + i * step_x in camera
 // coordinates, i < kBlockSide; its voxels at r * kBlockSide in the arrays); fused_pixel[i] gets
@@ -149,7 +150,6 @@ template <auto depth_at>
   // A local copy: through the reference, every store to the pools could alias the constants,
   // and each row reloaded all of them.
   const FrameConstants k = constants;
-  constexpr int kFloatsPerLine = 64 / sizeof(float);
   for (int z = 0; z < kBlockSide; ++z) {
     // The first voxel of each of the slice's rows, one row per lane: computed row by row, these
     // scalar sums were a sixth of the block's instructions.

@@ -41,8 +41,8 @@ struct HemiCnnTrainParams {
   std::uint64_t seed = 1;
 };
 
-// Trains a network of the given config on the dataset; config.image_size and
-// config.projection are taken from the dataset. model.training_info gets the parameters, the
+// Trains a network of the given config on the dataset; config.image_size, config.projection
+// and config.input are taken from the dataset. model.training_info gets the parameters, the
 // split, the loss history and the best validation loss ("final"). Shows a progress bar on a
 // terminal. Throws glint::Error for invalid params, an empty training split, or sequences with
 // fewer images than set_size.

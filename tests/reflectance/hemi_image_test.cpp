@@ -102,7 +102,7 @@ TEST(HemiImage, ReflectanceScaleFloorsGrazingAndBackLitIrradiance) {
   const Eigen::Vector3f position = Eigen::Vector3f::Zero(), normal = Eigen::Vector3f::UnitY();
   std::vector<render::PointLight> lights(1);
   lights[0].intensity = {4, 4, 0};  // no blue at all
-  lights[0].position = {0, -2, 0};  // behind the surface
+  lights[0].position = {0, -2, 0};  // behind the surface; head-on it would give 4 / 2^2 = 1
   const Eigen::Vector3f floored(float(M_PI) / (kMinIrradianceShare * 1.0f),
                                 float(M_PI) / (kMinIrradianceShare * 1.0f), 0.0f);
   EXPECT_TRUE(reflectance_scale(lights, position, normal).isApprox(floored, 1e-6f));
