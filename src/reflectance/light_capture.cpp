@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "render/perceptual.h"
 
 namespace glint::reflectance {
 
@@ -18,7 +19,7 @@ std::vector<LightSample> bright_samples(const ImageF& linear_rgb, const ImageF& 
     for (int x = 0; x < depth.width(); ++x) {
       const Eigen::Vector3f rgb(linear_rgb.at(x, y, 0), linear_rgb.at(x, y, 1),
                                 linear_rgb.at(x, y, 2));
-      const float luminance = 0.2126f * rgb.x() + 0.7152f * rgb.y() + 0.0722f * rgb.z();
+      const float luminance = render::luminance(rgb);
       const float z = depth.at(x, y, 0);
       if (luminance < params.min_luminance || !(z > 0) || !std::isfinite(z)) continue;
       LightSample s;

@@ -6,15 +6,12 @@
 
 #include "core/error.h"
 #include "io/image_io.h"
+#include "render/perceptual.h"
 
 namespace glint::render {
 namespace {
 
 constexpr float kPi = float(M_PI);
-
-float luminance(const Eigen::Vector3f& rgb) {
-  return 0.2126f * rgb.x() + 0.7152f * rgb.y() + 0.0722f * rgb.z();
-}
 
 // Index of the interval of a monotone CDF (size n+1, cdf[0]=0, cdf[n]=1) containing x.
 int find_interval(const float* cdf, int n, float x) {

@@ -17,6 +17,11 @@ struct PerceptualWard {
   float d = 0.9f;                          // distinctness of image, 1 - alpha
 };
 
+// Relative luminance Y of linear RGB (sRGB primaries, D65).
+inline float luminance(const Eigen::Vector3f& rgb) {
+  return 0.2126f * rgb.x() + 0.7152f * rgb.y() + 0.0722f * rgb.z();
+}
+
 // Linear RGB (sRGB primaries, D65) <-> CIELAB.
 Eigen::Vector3f linear_rgb_to_lab(const Eigen::Vector3f& rgb);
 Eigen::Vector3f lab_to_linear_rgb(const Eigen::Vector3f& lab);
