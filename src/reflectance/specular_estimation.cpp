@@ -83,13 +83,17 @@ void SpecularEstimator::update(const ObservationGrid& grid, const SegmentMap& se
     }
     for (int k = sampled; k < count; ++k) voxels[std::size_t(k)] = voxels[std::size_t(k % sampled)];
     std::vector<float> images(std::size_t(count) * image_floats);
-    for (int k = 0; k < count; ++k) {
+    for (int k = 0; k < sampled; ++k) {
       const int v = voxels[k];
       const Eigen::Vector3f scale =
           hemi_input_scale(network_.input(), lights, grid.position(v), grid.normal(v));
       make_hemi_image(grid.observations(v), grid.observation_count(v), grid.normal(v), hemi_,
                       images.data() + std::size_t(k) * image_floats, scale);
     }
+    // The repeated voxels' images are copies, not made again.
+    for (int k = sampled; k < count; ++k)
+      std::copy_n(images.data() + std::size_t(k % sampled) * image_floats, image_floats,
+                  images.data() + std::size_t(k) * image_floats);
     estimates[i] = render::from_perceptual(network_.predict(images.data(), count));
     if (!params_.fit_lobe) return;
     std::vector<FitVoxel> fit_voxels(count);
