@@ -75,27 +75,6 @@ bool target_matches(const render::PerceptualWard& stored, const render::Perceptu
 
 }  // namespace
 
-const char* hemi_projection_name(HemiProjection projection) {
-  return projection == HemiProjection::parabolic ? "parabolic" : "orthographic";
-}
-
-HemiProjection parse_hemi_projection(const std::string& name, const std::string& where) {
-  if (name == "parabolic") return HemiProjection::parabolic;
-  if (name == "orthographic") return HemiProjection::orthographic;
-  throw Error(where, "projection",
-              fmt::format("unknown projection \"{}\" (parabolic or orthographic)", name));
-}
-
-const char* hemi_input_name(HemiInput input) {
-  return input == HemiInput::radiance ? "radiance" : "reflectance";
-}
-
-HemiInput parse_hemi_input(const std::string& name, const std::string& where) {
-  if (name == "radiance") return HemiInput::radiance;
-  if (name == "reflectance") return HemiInput::reflectance;
-  throw Error(where, "input", fmt::format("unknown input \"{}\" (radiance or reflectance)", name));
-}
-
 HemiDataset read_hemi_dataset(const std::string& directory) {
   const std::filesystem::path folder(directory);
   const std::string index_path = (folder / "index.json").string();

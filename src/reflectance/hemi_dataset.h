@@ -29,13 +29,6 @@ namespace glint::reflectance {
 inline constexpr int kMinHemiImages = 25;   // one set of the HemiCNN's input
 inline constexpr int kMaxHemiImages = 500;  // the paper's hemi-images per sequence
 
-// "parabolic" / "orthographic" and back; an unknown name -> glint::Error(where, "projection").
-const char* hemi_projection_name(HemiProjection projection);
-HemiProjection parse_hemi_projection(const std::string& name, const std::string& where);
-// "radiance" / "reflectance" and back; an unknown name -> glint::Error(where, "input").
-const char* hemi_input_name(HemiInput input);
-HemiInput parse_hemi_input(const std::string& name, const std::string& where);
-
 struct HemiSequence {
   std::string file;    // npy file name inside the dataset folder
   std::string source;  // where the images came from (free text)

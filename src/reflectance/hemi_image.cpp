@@ -12,6 +12,27 @@
 
 namespace glint::reflectance {
 
+const char* hemi_projection_name(HemiProjection projection) {
+  return projection == HemiProjection::parabolic ? "parabolic" : "orthographic";
+}
+
+HemiProjection parse_hemi_projection(const std::string& name, const std::string& where) {
+  if (name == "parabolic") return HemiProjection::parabolic;
+  if (name == "orthographic") return HemiProjection::orthographic;
+  throw Error(where, "projection",
+              fmt::format("unknown projection \"{}\" (parabolic or orthographic)", name));
+}
+
+const char* hemi_input_name(HemiInput input) {
+  return input == HemiInput::radiance ? "radiance" : "reflectance";
+}
+
+HemiInput parse_hemi_input(const std::string& name, const std::string& where) {
+  if (name == "radiance") return HemiInput::radiance;
+  if (name == "reflectance") return HemiInput::reflectance;
+  throw Error(where, "input", fmt::format("unknown input \"{}\" (radiance or reflectance)", name));
+}
+
 Eigen::Matrix3f local_frame(const Eigen::Vector3f& n) {
   // Duff, Burgess, Christensen, Hery, Kensler, Liani, Villemin: "Building an Orthonormal Basis,
   // Revisited", JCGT 2017.

@@ -6,6 +6,7 @@
 //  - parabolic (paper 1, default): u = x / (1 + z), v = y / (1 + z) (keeps flat angles apart)
 //  - orthographic (Kim et al. 2017, the unmodified HemiCNN): u = x, v = y
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "reflectance/observation.h"
@@ -21,6 +22,13 @@ enum class HemiProjection { parabolic, orthographic };
 //    pi over the point lights' irradiance at the voxel, so that a Lambertian surface shows its
 //    albedo kd in every pixel whatever the lights, and a lobe rises above it
 enum class HemiInput { radiance, reflectance };
+
+// "parabolic" / "orthographic" and back; an unknown name -> glint::Error(where, "projection").
+const char* hemi_projection_name(HemiProjection projection);
+HemiProjection parse_hemi_projection(const std::string& name, const std::string& where);
+// "radiance" / "reflectance" and back; an unknown name -> glint::Error(where, "input").
+const char* hemi_input_name(HemiInput input);
+HemiInput parse_hemi_input(const std::string& name, const std::string& where);
 
 // Hemi-image sizes glint supports (pixels per side).
 inline constexpr int kMinHemiImageSize = 3, kMaxHemiImageSize = 64;
