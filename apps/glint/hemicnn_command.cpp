@@ -306,6 +306,12 @@ void register_hemicnn_train(CLI::App& hemicnn) {
                    "threads trained 2-10x slower on a 2-core machine)")
       ->check(kPositive)
       ->capture_default_str();
+  command
+      ->add_option("--weight-averaging", options->params.weight_averaging,
+                   "Decay of an exponential moving average of the weights, which is validated "
+                   "and kept in their place (e.g. 0.999; 0 = off)")
+      ->check(CLI::Range(0.0, 0.9999999))
+      ->capture_default_str();
   command->add_flag("!--no-rotate", options->params.rotate,
                     "No random quarter turns of the sets (default: each set turned by a random "
                     "multiple of 90 degrees)");

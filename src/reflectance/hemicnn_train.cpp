@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <random>
 
 #include "core/best_parameters.h"
@@ -129,6 +130,8 @@ void check_params(const HemiCnnTrainParams& params) {
   if (params.validation_sets < 1) throw Error(where, "validation_sets", "must be >= 1");
   if (params.log_every < 1) throw Error(where, "log_every", "must be >= 1");
   if (params.threads < 1) throw Error(where, "threads", "must be >= 1");
+  if (!(params.weight_averaging >= 0.0 && params.weight_averaging < 1.0))
+    throw Error(where, "weight_averaging", "must be in [0, 1)");
 }
 
 // Copies image `source` (3 x size x size) turned by quarter_turns * 90 degrees into `target`.
@@ -198,6 +201,14 @@ torch::Tensor targets_tensor(const std::vector<const HemiSequence*>& sequences) 
 torch::Tensor perceptual_loss(const torch::Tensor& outputs, const torch::Tensor& targets,
                               const torch::Tensor& weights) {
   return ((outputs - targets).square() * weights).sum(1).mean();
+}
+
+// Mean absolute error per target over the sets: L, a, b (Lab), c (mean of the three channels)
+// and d, the terms of eq. (5) one by one.
+nlohmann::json target_errors(const torch::Tensor& outputs, const torch::Tensor& targets) {
+  const torch::Tensor errors = (outputs - targets).abs().mean(0).contiguous();
+  const float* e = errors.data_ptr<float>();
+  return {{"L", e[0]}, {"a", e[1]}, {"b", e[2]}, {"c", (e[3] + e[4] + e[5]) / 3}, {"d", e[6]}};
 }
 
 void compute_standardisations(const HemiDataset& data, const std::vector<int>& training,
@@ -281,6 +292,37 @@ torch::Tensor evaluate_outputs(HemiNet& net, std::vector<float>& images, std::in
   return torch::cat(chunks, 0);
 }
 
+// Exponential moving average of a module's parameters (HemiCnnTrainParams::weight_averaging).
+class WeightAverage {
+ public:
+  WeightAverage(const std::vector<torch::Tensor>& parameters, double decay) : decay_(decay) {
+    for (const torch::Tensor& p : parameters) average_.push_back(p.detach().clone());
+  }
+
+  void update(const std::vector<torch::Tensor>& parameters) {
+    torch::NoGradGuard no_grad;
+    ++updates_;
+    const double decay = std::min(decay_, (1.0 + updates_) / (10.0 + updates_));
+    for (std::size_t i = 0; i < average_.size(); ++i)
+      average_[i].mul_(decay).add_(parameters[i].detach(), 1.0 - decay);
+  }
+
+  // Exchanges the parameters' values with the average's; a second call exchanges them back.
+  void exchange(const std::vector<torch::Tensor>& parameters) {
+    torch::NoGradGuard no_grad;
+    for (std::size_t i = 0; i < average_.size(); ++i) {
+      const torch::Tensor own = parameters[i].detach().clone();
+      parameters[i].data().copy_(average_[i]);
+      average_[i].copy_(own);
+    }
+  }
+
+ private:
+  double decay_;
+  long updates_ = 0;
+  std::vector<torch::Tensor> average_;
+};
+
 }  // namespace
 
 HemiCnn train_hemicnn(const HemiDataset& data, HemiCnnConfig config,
@@ -343,6 +385,9 @@ HemiCnn train_hemicnn(const HemiDataset& data, HemiCnnConfig config,
   double window_loss = 0.0, last_train_loss = std::nan("");
   int window_size = 0;
 
+  std::optional<WeightAverage> average;
+  if (params.weight_averaging > 0.0) average.emplace(net->parameters(), params.weight_averaging);
+
   ProgressBar progress("train", static_cast<std::size_t>(params.batches));
   for (int batch = 1; batch <= params.batches; ++batch) {
     for (int b = 0; b < params.batch_size; ++b) {
@@ -355,6 +400,7 @@ HemiCnn train_hemicnn(const HemiDataset& data, HemiCnnConfig config,
         targets_tensor(batch_sequences), weights);
     loss.backward();
     optimiser.step();
+    if (average) average->update(net->parameters());
     window_loss += loss.item<double>();
     ++window_size;
     progress.advance();
@@ -367,22 +413,26 @@ HemiCnn train_hemicnn(const HemiDataset& data, HemiCnnConfig config,
     if (validation_set_count == 0) {
       log().info("batch {}/{}: training loss {:.5f}", batch, params.batches, last_train_loss);
     } else {
+      if (average) average->exchange(net->parameters());
       net->eval();
+      const torch::Tensor outputs = evaluate_outputs(
+          net, validation_sets.images, validation_set_count, params.set_size, data.size);
       const double validation_loss =
-          perceptual_loss(evaluate_outputs(net, validation_sets.images, validation_set_count,
-                                           params.set_size, data.size),
-                          validation_sets.targets, weights)
-              .item<double>();
+          perceptual_loss(outputs, validation_sets.targets, weights).item<double>();
       net->train();
       entry["validation_loss"] = validation_loss;
-      log().info("batch {}/{}: training loss {:.5f}, validation loss {:.5f}", batch, params.batches,
-                 last_train_loss, validation_loss);
+      entry["validation_mae"] = target_errors(outputs, validation_sets.targets);
+      log().info("batch {}/{}: training loss {:.5f}, validation loss {:.5f}{}", batch,
+                 params.batches, last_train_loss, validation_loss,
+                 average ? " (averaged weights)" : "");
       best_parameters.offer(net->parameters(), validation_loss, batch);
+      if (average) average->exchange(net->parameters());
     }
     history.push_back(entry);
   }
   progress.finish();
 
+  if (average && best_parameters.step() < 0) average->exchange(net->parameters());
   if (best_parameters.restore(net->parameters()))
     log().info("kept the weights of batch {} (lowest validation loss {:.5f})",
                best_parameters.step(), best_parameters.loss());
@@ -402,6 +452,7 @@ HemiCnn train_hemicnn(const HemiDataset& data, HemiCnnConfig config,
                          {"lambda_d", params.loss.lambda_d},
                          {"lambda_l", params.loss.lambda_l},
                          {"rotate", params.rotate},
+                         {"weight_averaging", params.weight_averaging},
                          {"seed", params.seed},
                          {"validation_fraction", params.validation_fraction},
                          {"validation_sets_per_sequence", params.validation_sets},

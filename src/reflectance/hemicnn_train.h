@@ -13,6 +13,10 @@
 // Validation: the last validation_fraction of the sequences (by index) are held out; from
 // each, validation_sets fixed random sets are drawn once; their mean loss is logged every
 // log_every batches and the weights with the lowest validation loss are kept.
+// Weight averaging (`weight_averaging` > 0): an exponential moving average of the weights
+// (Polyak averaging) is kept beside them, validated and returned in their place; its decay
+// ramps up as min(decay, (1 + t) / (10 + t)) over the first batches t, so the average does not
+// keep the random initialisation.
 // Standardisations: input mean/std per channel of log1p(radiance) over (up to 64 images of)
 // every training sequence; target mean/std over the training sequences.
 // Determinism: the same data, config, params and thread count give bit-identical weights
@@ -38,6 +42,7 @@ struct HemiCnnTrainParams {
   int log_every = 500;               // batches between validation evaluations / log lines
   bool rotate = true;                // random quarter turns, the same for a whole set
   int threads = 1;                   // torch intra-op threads (see above)
+  double weight_averaging = 0.0;     // decay of the weights' moving average; 0 = off
   std::uint64_t seed = 1;
 };
 

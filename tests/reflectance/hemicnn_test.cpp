@@ -449,6 +449,21 @@ TEST(HemiCnnTrain, LowersTheValidationLossAndAgreesWithPlainInference) {
   for (const auto& entry : info["history"])
     lowest = std::min(lowest, entry["validation_loss"].get<double>());
   EXPECT_EQ(best, lowest);  // the kept weights are the best ones
+  // Each evaluation also logs the mean absolute error of every target. Eq. (5) sums the
+  // weighted mean squared errors, so each term bounds its error: w * MAE^2 <= loss (the c term
+  // is the mean of three channels, each weighted alike).
+  const std::array<double, HemiCnn::kTargets> w = loss_weights(short_training(1).loss);
+  for (const auto& entry : info["history"]) {
+    const nlohmann::json& mae = entry["validation_mae"];
+    const double loss = entry["validation_loss"].get<double>() * (1 + 1e-5);
+    const double c = mae["c"].get<double>();
+    EXPECT_LE(w[0] * std::pow(mae["L"].get<double>(), 2), loss);
+    EXPECT_LE(w[1] * std::pow(mae["a"].get<double>(), 2), loss);
+    EXPECT_LE(w[2] * std::pow(mae["b"].get<double>(), 2), loss);
+    EXPECT_LE(3 * w[3] * c * c, loss);
+    EXPECT_LE(w[6] * std::pow(mae["d"].get<double>(), 2), loss);
+    EXPECT_GT(mae["L"].get<double>() + c, 0.0);
+  }
 
   // The standardisations come from the training sequences.
   double mean_l = 0;
@@ -476,6 +491,29 @@ TEST(HemiCnnTrain, SameSeedGivesIdenticalWeights) {
   EXPECT_NE(train_hemicnn(data, small_config(), other).layers[0].weights, a.layers[0].weights);
 }
 
+TEST(HemiCnnTrain, WeightAveragingKeepsTheRampedMovingAverage) {
+  const TempDir dir;
+  write_dataset(dir.file("set"), 6, 25, 7);
+  const HemiDataset data = read_hemi_dataset(dir.file("set"));
+  HemiCnnTrainParams params = short_training(0);
+  params.validation_fraction = 0.0;  // keep the last (averaged) weights
+  const HemiCnn initial = train_hemicnn(data, small_config(), params);
+  params.batches = 1;
+  const HemiCnn stepped = train_hemicnn(data, small_config(), params);
+  params.weight_averaging = 0.999;
+  const HemiCnn averaged = train_hemicnn(data, small_config(), params);
+  EXPECT_EQ(averaged.training_info["weight_averaging"], 0.999);
+  // One update with the ramped decay min(0.999, (1 + 1) / (10 + 1)) = 2/11.
+  int differing = 0;
+  for (std::size_t l = 0; l < initial.layers.size(); ++l)
+    for (std::size_t k = 0; k < initial.layers[l].weights.size(); ++k) {
+      const float w0 = initial.layers[l].weights[k], w1 = stepped.layers[l].weights[k];
+      EXPECT_NEAR(averaged.layers[l].weights[k], (2 * w0 + 9 * w1) / 11, 1e-6f);
+      differing += w0 != w1;
+    }
+  EXPECT_GT(differing, 0);  // the step moved the weights, so the average is not trivially equal
+}
+
 TEST(HemiCnnTrain, RejectsBadParameters) {
   const TempDir dir;
   write_dataset(dir.file("set"), 2, 25, 6);
@@ -490,6 +528,7 @@ TEST(HemiCnnTrain, RejectsBadParameters) {
   rejects([](HemiCnnTrainParams& p) { p.set_size = 26; });  // sequences hold 25 images
   rejects([](HemiCnnTrainParams& p) { p.validation_fraction = 1.0; });
   rejects([](HemiCnnTrainParams& p) { p.loss.lambda_d = -1; });
+  rejects([](HemiCnnTrainParams& p) { p.weight_averaging = 1.0; });
 }
 
 }  // namespace
