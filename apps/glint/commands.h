@@ -34,7 +34,7 @@ void register_render_command(CLI::App& app);
 void register_synth_command(CLI::App& app);
 // `glint fuse DATASET -o MESH.ply` (apps/glint/fuse_command.cpp).
 void register_fuse_command(CLI::App& app);
-// `glint hemicnn dataset|train|predict` (apps/glint/hemicnn_commands.cpp).
+// `glint hemicnn dataset|train|predict|probe` (apps/glint/hemicnn_commands.cpp).
 void register_hemicnn_commands(CLI::App& app);
 // `glint hemicnn dataset TRAINSET -o DIR` (apps/glint/hemicnn_dataset.cpp).
 void register_hemicnn_dataset(CLI::App& hemicnn);
@@ -42,6 +42,8 @@ void register_hemicnn_dataset(CLI::App& hemicnn);
 // (apps/glint/hemicnn_command.cpp).
 void register_hemicnn_train(CLI::App& hemicnn);
 void register_hemicnn_predict(CLI::App& hemicnn);
+// `glint hemicnn probe --model MODEL` (apps/glint/hemicnn_probe.cpp).
+void register_hemicnn_probe(CLI::App& hemicnn);
 // `glint reconstruct SEQ -o OUT` (apps/glint/reconstruct_command.cpp).
 void register_reconstruct_command(CLI::App& app);
 // `glint lights CAPTURE -o lights.json` (apps/glint/lights_command.cpp).
