@@ -146,8 +146,6 @@ Errors errors_of(const render::PerceptualWard& estimate, const render::Perceptua
   return e;
 }
 
-nlohmann::json vector_json(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
-
 void run_predict(const PredictOptions& options) {
   const Stopwatch total;
   StageTimings timings;
@@ -197,8 +195,8 @@ void run_predict(const PredictOptions& options) {
     mean.add(sequence_errors);
     per_sequence.push_back({{"file", sequence.file},
                             {"source", sequence.source},
-                            {"kd", vector_json(sequence.material.kd)},
-                            {"ks", vector_json(sequence.material.ks)},
+                            {"kd", io::vector_json(sequence.material.kd)},
+                            {"ks", io::vector_json(sequence.material.ks)},
                             {"alpha", sequence.material.alpha},
                             {"mean_absolute_error", sequence_errors.to_json()}});
     progress.advance();

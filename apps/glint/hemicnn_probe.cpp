@@ -65,8 +65,6 @@ Eigen::Vector3f parse_albedo(const std::string& text) {
   return {values[0], values[1], values[2]};
 }
 
-nlohmann::json vector_json(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
-
 void run_probe(const ProbeOptions& options) {
   const reflectance::HemiCnn model = reflectance::HemiCnn::load(options.model);
   if (model.input() != reflectance::HemiInput::reflectance)
@@ -104,9 +102,9 @@ void run_probe(const ProbeOptions& options) {
         "{:.3f}    {:.3f}\n",
         albedo.x(), albedo.y(), albedo.z(), ward.kd.x(), ward.kd.y(), ward.kd.z(), ratio,
         ward.ks.x(), ward.ks.y(), ward.ks.z(), ward.alpha);
-    probes.push_back({{"albedo", vector_json(albedo)},
-                      {"kd", vector_json(ward.kd)},
-                      {"ks", vector_json(ward.ks)},
+    probes.push_back({{"albedo", io::vector_json(albedo)},
+                      {"kd", io::vector_json(ward.kd)},
+                      {"ks", io::vector_json(ward.ks)},
                       {"alpha", ward.alpha}});
   }
   fmt::print(

@@ -29,8 +29,6 @@ struct LightsOptions {
   reflectance::LightEstimationParams params;
 };
 
-nlohmann::json vector_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
-
 // The capture folder's ground-truth lights (scene.json), or none with a warning saying why.
 std::vector<render::PointLight> ground_truth_lights(const std::string& folder) {
   const std::string path = (std::filesystem::path(folder) / "scene.json").string();
@@ -66,10 +64,10 @@ nlohmann::json compare_with_ground_truth(const reflectance::LightEstimate& estim
     comparisons.push_back(
         {{"light", l},
          {"ground_truth", nearest},
-         {"ground_truth_position", vector_json(truth[nearest].position)},
-         {"ground_truth_intensity", vector_json(truth[nearest].intensity.cast<double>())},
+         {"ground_truth_position", io::vector_json(truth[nearest].position)},
+         {"ground_truth_intensity", io::vector_json(truth[nearest].intensity.cast<double>())},
          {"position_error_m", error},
-         {"intensity_ratio", vector_json(ratio.cast<double>())}});
+         {"intensity_ratio", io::vector_json(ratio.cast<double>())}});
   }
   if (estimate.lights.size() != truth.size())
     log().warn("found {} lights, the ground truth has {}", estimate.lights.size(), truth.size());
@@ -102,8 +100,8 @@ void run_lights(const LightsOptions& options) {
         l, light.position.x(), light.position.y(), light.position.z(), light.intensity.x(),
         light.intensity.y(), light.intensity.z(), 100 * light.proxy_radius_m, support.frames,
         support.pixels, 100 * support.position_spread_m);
-    lights.push_back({{"position", vector_json(light.position)},
-                      {"intensity", vector_json(light.intensity.cast<double>())},
+    lights.push_back({{"position", io::vector_json(light.position)},
+                      {"intensity", io::vector_json(light.intensity.cast<double>())},
                       {"radius_m", light.proxy_radius_m},
                       {"frames", support.frames},
                       {"pixels", support.pixels},

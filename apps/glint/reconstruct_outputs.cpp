@@ -20,10 +20,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-nlohmann::json vector_json(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
-
 nlohmann::json ward_json(const render::WardMaterial& m) {
-  return {{"kd", vector_json(m.kd)}, {"ks", vector_json(m.ks)}, {"alpha", m.alpha}};
+  return {{"kd", io::vector_json(m.kd)}, {"ks", io::vector_json(m.ks)}, {"alpha", m.alpha}};
 }
 
 ImageF srgb_picture(const ImageF& linear) {
@@ -131,7 +129,7 @@ nlohmann::json materials_json(const reflectance::ReflectancePipeline& pipeline) 
     if (const auto found = refined.find(id); found != refined.end()) {
       const RefinedSums& sums = found->second;
       const Sum& sum = sums.reliable.voxels > 0 ? sums.reliable : sums.all;
-      entry["kd_refined_mean"] = vector_json((sum.kd / sum.voxels).cast<float>());
+      entry["kd_refined_mean"] = io::vector_json((sum.kd / sum.voxels).cast<float>());
     }
     segments.push_back(entry);
   }

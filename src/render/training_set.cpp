@@ -135,17 +135,14 @@ std::vector<Pose> training_arc(const Intrinsics& intrinsics, const Eigen::Vector
   return orbit_trajectory(orbit);
 }
 
-nlohmann::json vector_json(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
-nlohmann::json vector_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
-
 nlohmann::json sequence_json(const Scene& scene, const std::string& folder) {
   const Object& object = scene.objects.front();
   const WardMaterial& ward = object.material.ward;
   const PerceptualWard perceptual = to_perceptual(ward);
   nlohmann::json lights = nlohmann::json::array();
   for (const PointLight& light : scene.lights)
-    lights.push_back(
-        {{"position", vector_json(light.position)}, {"intensity", vector_json(light.intensity)}});
+    lights.push_back({{"position", io::vector_json(light.position)},
+                      {"intensity", io::vector_json(light.intensity)}});
   nlohmann::json environment = nullptr;
   if (scene.environment)
     environment = {{"path", scene.environment->path},
@@ -153,13 +150,13 @@ nlohmann::json sequence_json(const Scene& scene, const std::string& folder) {
                    {"rotation_deg", scene.environment->rotation_deg}};
   return {{"folder", folder},
           {"shape", object.name},
-          {"size", vector_json(object.size)},
+          {"size", io::vector_json(object.size)},
           {"material",
-           {{"kd", vector_json(ward.kd)},
-            {"ks", vector_json(ward.ks)},
+           {{"kd", io::vector_json(ward.kd)},
+            {"ks", io::vector_json(ward.ks)},
             {"alpha", ward.alpha},
-            {"lab", vector_json(perceptual.lab)},
-            {"c", vector_json(perceptual.c)},
+            {"lab", io::vector_json(perceptual.lab)},
+            {"c", io::vector_json(perceptual.c)},
             {"d", perceptual.d}}},
           {"lights", lights},
           {"environment", environment}};
