@@ -10,7 +10,9 @@
 # Each training: 30,000 batches of 32 sets, Adam lr 1e-4, seed 1, one core. About 11 + 3 + 2 x
 # (8 to 13) minutes on 2 cores (rendering, hemi-images, then two pairs of trainings side by side,
 # one core each); the set and its hemi-images take about 13 GB on disk, each training about
-# 2.7 GB of memory.
+# 2.7 GB of memory. Each network's validation errors go to WORK/predict-*.json, and the
+# reflectance networks' answers for matte greys and colours (glint hemicnn probe) to
+# WORK/probe-*.json.
 #   scripts/train-hemicnn.sh GLINT DATA [WORK]
 set -euo pipefail
 GLINT=${1:?usage: train-hemicnn.sh GLINT DATA [WORK]}
@@ -37,4 +39,9 @@ for input in reflectance radiance; do
   "$GLINT" hemicnn predict "$WORK/hemi/orthographic$folder" \
     --model "$MODELS/hemicnn-unmodified$suffix.json" \
     --report "$WORK/predict-unmodified$suffix.json"
+  if [[ $input == reflectance ]]; then  # the networks' kd for matte greys and colours
+    "$GLINT" hemicnn probe --model "$MODELS/hemicnn.json" --report "$WORK/probe-modified.json"
+    "$GLINT" hemicnn probe --model "$MODELS/hemicnn-unmodified.json" \
+      --report "$WORK/probe-unmodified.json"
+  fi
 done
