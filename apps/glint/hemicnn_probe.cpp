@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "io/json_report.h"
 #include "reflectance/hemicnn.h"
+#include "reflectance/specular_estimation.h"
 #include "render/perceptual.h"
 
 namespace glint::app {
@@ -22,20 +23,15 @@ namespace {
 
 // The default probes: a grey ramp, then the evaluation scenes' kinds of colour (a light wall,
 // a saturated yellow, a dark green, a blue-grey).
-const char* const kDefaultProbes[] = {"0.05",
-                                      "0.1",
-                                      "0.2",
-                                      "0.3",
-                                      "0.4",
-                                      "0.5",
-                                      "0.6",
-                                      "0.7",
-                                      "0.8",
-                                      "0.9",
-                                      "0.69,0.67,0.61",
-                                      "0.75,0.55,0.04",
-                                      "0.05,0.2,0.08",
-                                      "0.3,0.35,0.4"};
+std::vector<Eigen::Vector3f> default_albedos() {
+  std::vector<Eigen::Vector3f> albedos;
+  for (float grey : {0.05f, 0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f, 0.7f, 0.8f, 0.9f})
+    albedos.push_back(Eigen::Vector3f::Constant(grey));
+  albedos.insert(
+      albedos.end(),
+      {{0.69f, 0.67f, 0.61f}, {0.75f, 0.55f, 0.04f}, {0.05f, 0.2f, 0.08f}, {0.3f, 0.35f, 0.4f}});
+  return albedos;
+}
 
 struct ProbeOptions {
   std::string model;
@@ -72,28 +68,28 @@ void run_probe(const ProbeOptions& options) {
                 "a radiance model: its input for a Lambertian surface depends on the lights; "
                 "probe takes models of reflectance hemi-images");
   std::vector<Eigen::Vector3f> albedos;
-  if (options.albedos.empty())
-    for (const char* probe : kDefaultProbes) albedos.push_back(parse_albedo(probe));
   for (const std::string& text : options.albedos) albedos.push_back(parse_albedo(text));
+  if (albedos.empty()) albedos = default_albedos();
 
-  constexpr int kSetSize = 25;  // paper 1: 25 voxels per segment
+  // As many images as the pipeline's specular estimate hands the network per segment.
+  const int set_size = reflectance::SpecularParams{}.voxels_per_estimate;
   const std::size_t floats = model.image_floats();
   const std::size_t pixels = floats / 3;
-  std::vector<float> images(kSetSize * floats);
+  std::vector<float> images(set_size * floats);
   fmt::print(
       "HemiCNN {} ({}, reflectance): {} constant hemi-images per albedo, what a\n"
       "Lambertian surface shows under any lights\n"
       "  albedo               -> kd                   kd/albedo  ks                     "
       "alpha\n",
-      options.model, reflectance::hemi_projection_name(model.projection()), kSetSize);
+      options.model, reflectance::hemi_projection_name(model.projection()), set_size);
   nlohmann::json probes = nlohmann::json::array();
   double kd_error = 0;
   for (const Eigen::Vector3f& albedo : albedos) {
-    for (int i = 0; i < kSetSize; ++i)
+    for (int i = 0; i < set_size; ++i)
       for (int c = 0; c < 3; ++c)
         std::fill_n(images.begin() + std::ptrdiff_t(i * floats + c * pixels), pixels, albedo[c]);
     const render::WardMaterial ward =
-        render::from_perceptual(model.predict(images.data(), kSetSize));
+        render::from_perceptual(model.predict(images.data(), set_size));
     // Ratio of the mean channels: how much brighter or darker the network makes the surface.
     const float ratio = albedo.mean() > 0 ? ward.kd.mean() / albedo.mean() : NAN;
     kd_error += (ward.kd - albedo).cwiseAbs().mean() / double(albedos.size());
@@ -115,7 +111,7 @@ void run_probe(const ProbeOptions& options) {
     io::write_json(options.report, {{"command", "hemicnn probe"},
                                     {"command_line", command_line()},
                                     {"model", options.model},
-                                    {"set_size", kSetSize},
+                                    {"set_size", set_size},
                                     {"kd_mean_absolute_error", kd_error},
                                     {"probes", probes}});
     fmt::print("report -> {}\n", options.report);
