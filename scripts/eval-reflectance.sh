@@ -13,8 +13,8 @@
 #   - at 1 cm observation voxels (Table 3 timings);
 #   - "fast": 1 cm geometry voxels instead of 5 mm (a CPU budget option, not the paper's).
 # Every 10th frame (and the last) is scored; about 13 minutes on 2 cores for the three scenes
-# once they are rendered. SCENES may also name "heldout": bunnies with materials no training
-# choice was made on (scripts/heldout-scene.py), lit as bunnies.
+# once they are rendered. SCENES may also name "heldout" and "heldout-cubes": bunnies and cubes
+# with materials no training choice was made on (scripts/heldout-scene.py), lit as their bases.
 # Reports: OUT/<scene>-<variant>/report.json; a summary table: OUT/summary.md.
 #   scripts/eval-reflectance.sh GLINT DATA [OUT] [SCENES] [FRAMES]
 set -euo pipefail
@@ -27,12 +27,15 @@ MODELS=$(dirname "$0")/../models
 mkdir -p "$OUT"
 render_scene() {  # render_scene SCENE: OUT/seq-SCENE and OUT/capture-SCENE
   local scene=$1 seq="$OUT/seq-$1" cap="$OUT/capture-$1"
-  if [[ $scene == heldout ]]; then  # bunnies' geometry, lights and path, other materials
+  if [[ $scene == heldout* ]]; then  # a built-in scene's geometry, lights, path; other materials
     [[ -d "$seq" ]] && return 0
-    render_scene bunnies
-    python3 "$(dirname "$0")/heldout-scene.py" "$OUT/seq-bunnies/scene.json" "$OUT/heldout.json"
-    "$GLINT" --quiet render "$OUT/heldout.json" -o "$seq" --no-shadows
-    ln -sfn "capture-bunnies" "$cap"
+    local base=bunnies
+    [[ $scene == heldout-cubes ]] && base=cubes
+    render_scene $base
+    python3 "$(dirname "$0")/heldout-scene.py" "$scene" "$OUT/seq-$base/scene.json" \
+      "$OUT/$scene.json"
+    "$GLINT" --quiet render "$OUT/$scene.json" -o "$seq" --no-shadows
+    ln -sfn "capture-$base" "$cap"
     return 0
   fi
   [[ -d "$seq" ]] || "$GLINT" --quiet synth "$scene" -o "$seq" --frames "$FRAMES" --no-shadows \

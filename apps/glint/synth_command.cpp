@@ -29,6 +29,7 @@ struct SynthCommandOptions {
   std::string data_dir = render::default_data_dir();
   int sequences = render::TrainingSetParams{}.sequences;
   std::vector<std::string> shapes;  // training: empty = all
+  float near_grey_share = render::MaterialRanges{}.near_grey_share;
   bool no_ground_truth = false;
   bool no_shadows = false;
   bool preview = false;
@@ -54,6 +55,7 @@ nlohmann::json run_training_set(const SynthCommandOptions& options) {
   params.data_dir = options.data_dir;
   params.ground_truth = !options.no_ground_truth;
   params.shapes = options.shapes;
+  params.ranges.near_grey_share = options.near_grey_share;
   nlohmann::json report = render::training_set_parameters_json(params);
   if (options.preview) {
     report["render_ms"] =
@@ -169,6 +171,12 @@ void register_synth_command(CLI::App& app) {
                    "the meshes of DATA/meshes)")
       ->delimiter(',')
       ->check(CLI::IsMember(render::training_shape_names()));
+  command
+      ->add_option("--near-grey-share", options->near_grey_share,
+                   "training: share of albedos drawn with CIELAB chroma uniform in radius (1: "
+                   "near-greys about 11x as common as with a, b uniform in a square)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
   command->add_flag("--no-gt", options->no_ground_truth, "Do not write the gt/ maps");
   command->add_flag("--no-shadows", options->no_shadows, "Scenes: no shadow rays");
   command->add_flag("--preview", options->preview,

@@ -207,9 +207,18 @@ const std::vector<std::string>& training_shape_names() {
 
 WardMaterial sample_training_material(const MaterialRanges& ranges, SeededDraw& draw) {
   WardMaterial material;
+  const bool chroma_by_radius =
+      ranges.near_grey_share > 0 && draw.uniform(0, 1) < ranges.near_grey_share;
   do {
-    material.kd = lab_to_linear_rgb(
-        {float(draw.uniform(25, 96)), float(draw.uniform(-80, 80)), float(draw.uniform(-80, 80))});
+    const float lightness = float(draw.uniform(25, 96));
+    Eigen::Vector2f ab;
+    if (chroma_by_radius) {
+      const double chroma = draw.uniform(0, 80), hue = draw.uniform(0, 2 * M_PI);
+      ab = {float(chroma * std::cos(hue)), float(chroma * std::sin(hue))};
+    } else {
+      ab = {float(draw.uniform(-80, 80)), float(draw.uniform(-80, 80))};
+    }
+    material.kd = lab_to_linear_rgb({lightness, ab.x(), ab.y()});
   } while (material.kd.minCoeff() < ranges.kd_min || material.kd.maxCoeff() > ranges.kd_max);
   const float c = float(draw.uniform(0, ranges.c_max));
   for (int i = 0; i < 3; ++i) {
@@ -272,7 +281,8 @@ nlohmann::json training_set_parameters_json(const TrainingSetParams& params) {
           {"ranges",
            {{"kd", {r.kd_min, r.kd_max}},
             {"c", {0.0f, r.c_max}},
-            {"alpha", {r.alpha_min, r.alpha_max}}}}};
+            {"alpha", {r.alpha_min, r.alpha_max}},
+            {"near_grey_share", r.near_grey_share}}}};
 }
 
 TrainingSetStats write_training_set(const TrainingSetParams& params, const std::string& out_dir,
