@@ -11,9 +11,9 @@
 # Each training: 60,000 batches of 32 sets, Adam lr 1e-4, the weights' moving average (decay
 # 0.999) validated and kept, one core. The default model is trained with seeds 1 and 2 and the
 # one with the lower validation loss is kept (the recipe's criterion; never the scenes); the
-# other three use seed 1. About 22 + 7 + 3 x 15 minutes on 2 cores (rendering, hemi-images,
-# then the five trainings two at a time); the set and its hemi-images take about 30 GB on disk,
-# each training about 7 GB of memory. Each network's validation errors go to
+# other three use seed 1. About 22 + 10 + 3 x (15 to 25) minutes on 2 cores (rendering,
+# hemi-images, then the five trainings two at a time); the set and its hemi-images take about
+# 40 GB on disk, each training about 7 GB of memory. Each network's validation errors go to
 # WORK/predict-*.json, and the reflectance networks' answers for matte greys and colours (glint
 # hemicnn probe) to WORK/probe-*.json.
 #   scripts/train-hemicnn.sh GLINT DATA [WORK]
