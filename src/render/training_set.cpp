@@ -271,18 +271,21 @@ Scene make_training_scene(const TrainingSetParams& params, int index) {
 
 nlohmann::json training_set_parameters_json(const TrainingSetParams& params) {
   const MaterialRanges& r = params.ranges;
-  return {{"seed", params.seed},
-          {"frames", params.frames},
-          {"width", params.width},
-          {"height", params.height},
-          {"shapes", params.shapes.empty() ? training_shape_names() : params.shapes},
-          {"environment_probability", params.environment_probability},
-          {"ground_truth", params.ground_truth},
-          {"ranges",
-           {{"kd", {r.kd_min, r.kd_max}},
-            {"c", {0.0f, r.c_max}},
-            {"alpha", {r.alpha_min, r.alpha_max}},
-            {"near_grey_share", r.near_grey_share}}}};
+  nlohmann::json parameters = {
+      {"seed", params.seed},
+      {"frames", params.frames},
+      {"width", params.width},
+      {"height", params.height},
+      {"shapes", params.shapes.empty() ? training_shape_names() : params.shapes},
+      {"environment_probability", params.environment_probability},
+      {"ground_truth", params.ground_truth},
+      {"ranges",
+       {{"kd", {r.kd_min, r.kd_max}},
+        {"c", {0.0f, r.c_max}},
+        {"alpha", {r.alpha_min, r.alpha_max}}}}};
+  // Only when used, so that folders made before the option still resume (check_resumable).
+  if (r.near_grey_share > 0) parameters["ranges"]["near_grey_share"] = r.near_grey_share;
+  return parameters;
 }
 
 TrainingSetStats write_training_set(const TrainingSetParams& params, const std::string& out_dir,

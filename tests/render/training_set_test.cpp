@@ -89,6 +89,12 @@ TEST(TrainingMaterials, NearGreyShareMakesNearGreysCommon) {
   EXPECT_GT(radius, 4000 / 10);
   EXPECT_GT(half, 3 * square);
   EXPECT_LT(half, radius);
+  // The set's recorded parameters name the share only when it is used, so that sets made
+  // before the option keep their parameters and resume.
+  TrainingSetParams params;
+  EXPECT_FALSE(training_set_parameters_json(params)["ranges"].contains("near_grey_share"));
+  params.ranges.near_grey_share = 0.5f;
+  EXPECT_EQ(training_set_parameters_json(params)["ranges"]["near_grey_share"], 0.5f);
 }
 
 TEST(TrainingScenes, SameSeedSameSceneOtherIndexOtherScene) {
