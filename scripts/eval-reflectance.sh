@@ -29,9 +29,9 @@ render_scene() {  # render_scene SCENE: OUT/seq-SCENE and OUT/capture-SCENE
   local scene=$1 seq="$OUT/seq-$1" cap="$OUT/capture-$1"
   if [[ $scene == heldout* ]]; then  # a built-in scene's geometry, lights, path; other materials
     [[ -d "$seq" ]] && return 0
-    local base=bunnies
-    [[ $scene == heldout-cubes ]] && base=cubes
-    render_scene $base
+    local base
+    base=$(python3 "$(dirname "$0")/heldout-scene.py" base "$scene")
+    render_scene "$base"
     python3 "$(dirname "$0")/heldout-scene.py" "$scene" "$OUT/seq-$base/scene.json" \
       "$OUT/$scene.json"
     "$GLINT" --quiet render "$OUT/$scene.json" -o "$seq" --no-shadows

@@ -7,11 +7,13 @@ path with materials no training choice was made on.
   heldout-cubes  cubes with a warm light-grey floor and light-grey, purple, pale-pink, dark-grey,
                  olive and silver cubes: matte near-greys, which the training materials drew
                  rarely; made 2026-12-01 before any network was trained on the near-grey set.
-Reads the scene.json of the rendered base sequence, writes the edited copy; then
+`heldout-scene.py base NAME` prints NAME's base scene. Otherwise reads the scene.json of the
+rendered base sequence and writes the edited copy; then
   glint render OUT.json -o seq-heldout --no-shadows
   glint reconstruct seq-heldout --lights lights-bunnies.json --gt-poses --gt-segmentation ...
 (the lights are the base scene's, so its estimated lights.json serves).
-usage: heldout-scene.py {heldout,heldout-cubes} BASE_SEQ/scene.json OUT.json"""
+usage: heldout-scene.py base {heldout,heldout-cubes}
+       heldout-scene.py {heldout,heldout-cubes} BASE_SEQ/scene.json OUT.json"""
 import json
 import sys
 
@@ -36,6 +38,9 @@ SCENES = {
 
 
 def main():
+    if len(sys.argv) == 3 and sys.argv[1] == "base" and sys.argv[2] in SCENES:
+        print(SCENES[sys.argv[2]][0])
+        return
     if len(sys.argv) != 4 or sys.argv[1] not in SCENES:
         sys.exit(__doc__)
     base, materials = SCENES[sys.argv[1]]

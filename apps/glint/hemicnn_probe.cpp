@@ -13,6 +13,7 @@
 #include "cli_support.h"
 #include "commands.h"
 #include "core/error.h"
+#include "io/codec.h"
 #include "io/json_report.h"
 #include "reflectance/hemicnn.h"
 #include "reflectance/specular_estimation.h"
@@ -45,16 +46,10 @@ Eigen::Vector3f parse_albedo(const std::string& text) {
   std::stringstream stream(text);
   std::string item;
   while (std::getline(stream, item, ',')) {
-    std::size_t used = 0;
-    float value = NAN;
-    try {
-      value = std::stof(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size() || !(value >= 0.0f && value <= 1.0f))
+    double value = NAN;
+    if (!io::parse_number(item, value) || !(value >= 0.0 && value <= 1.0))
       throw Error("--kd", text, "expected a grey or r,g,b, each a number in [0, 1]");
-    values.push_back(value);
+    values.push_back(float(value));
   }
   if (values.size() == 1) return Eigen::Vector3f::Constant(values[0]);
   if (values.size() != 3) throw Error("--kd", text, "expected a grey or r,g,b");

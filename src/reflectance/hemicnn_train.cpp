@@ -432,6 +432,7 @@ HemiCnn train_hemicnn(const HemiDataset& data, HemiCnnConfig config,
   }
   progress.finish();
 
+  // Without validation nothing was kept: the average itself is the result.
   if (average && best_parameters.step() < 0) average->exchange(net->parameters());
   if (best_parameters.restore(net->parameters()))
     log().info("kept the weights of batch {} (lowest validation loss {:.5f})",
