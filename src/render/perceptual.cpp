@@ -55,9 +55,9 @@ PerceptualWard to_perceptual(const WardMaterial& m) {
 
 WardMaterial from_perceptual(const PerceptualWard& p) {
   WardMaterial m;
-  m.kd = lab_to_linear_rgb(p.lab);
+  m.kd = lab_to_linear_rgb(p.lab).cwiseMax(0.0f);
   for (int i = 0; i < 3; ++i) {
-    const float root_half_kd = std::cbrt(std::max(0.0f, m.kd[i]) / 2);
+    const float root_half_kd = std::cbrt(m.kd[i] / 2);
     const float root = p.c[i] + root_half_kd;
     m.ks[i] = root * root * root - root_half_kd * root_half_kd * root_half_kd;
   }

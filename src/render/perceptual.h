@@ -27,6 +27,9 @@ Eigen::Vector3f linear_rgb_to_lab(const Eigen::Vector3f& rgb);
 Eigen::Vector3f lab_to_linear_rgb(const Eigen::Vector3f& lab);
 
 PerceptualWard to_perceptual(const WardMaterial& material);
+// kd's channels are clamped at 0: a Lab colour outside the sRGB gamut (a network's prediction
+// for a saturated surface, e.g. a teal one's red) has a negative linear channel, which no
+// surface reflects.
 WardMaterial from_perceptual(const PerceptualWard& perceptual);
 
 }  // namespace glint::render

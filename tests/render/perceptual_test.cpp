@@ -50,5 +50,18 @@ TEST(Perceptual, RoundTripOverTheTrainingRanges) {
   EXPECT_TRUE(linear_rgb_to_lab(lab_to_linear_rgb(lab)).isApprox(lab, 1e-4f));
 }
 
+TEST(Perceptual, OutOfGamutColoursGiveNoNegativeAlbedo) {
+  // A saturated teal beyond the sRGB gamut: its linear red is negative.
+  PerceptualWard p;
+  p.lab = {50.0f, -60.0f, -20.0f};
+  p.c = {0.1f, 0.1f, 0.1f};
+  p.d = 0.9f;
+  ASSERT_LT(lab_to_linear_rgb(p.lab).x(), 0.0f);
+  const WardMaterial m = from_perceptual(p);
+  EXPECT_EQ(m.kd.x(), 0.0f);
+  EXPECT_GT(m.kd.y(), 0.0f);
+  EXPECT_NEAR(m.ks.x(), 0.001f, 1e-6f);  // kd 0: ks = c^3
+}
+
 }  // namespace
 }  // namespace glint::render
