@@ -25,7 +25,9 @@ MODELS=$(dirname "$0")/../models
 mkdir -p "$WORK"
 "$GLINT" synth training -o "$WORK/train" --sequences 6000 --seed 1 --near-grey-share 0.5 \
   --data "$DATA"
-[[ -f "$WORK/hemi/orthographic/index.json" ]] ||
+# orthographic-reflectance is the last of the four folders the dataset command finishes: its
+# index.json means all four are complete.
+[[ -f "$WORK/hemi/orthographic-reflectance/index.json" ]] ||
   "$GLINT" hemicnn dataset "$WORK/train" -o "$WORK/hemi"
 train() {  # train NAME KIND SEED [ARGS...]: WORK/NAME-sSEED.json from WORK/hemi/KIND
   local name=$1 kind=$2 seed=$3
