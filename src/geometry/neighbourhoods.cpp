@@ -199,7 +199,7 @@ struct Scratch {
   std::vector<float> distances;       // squared distance of each candidate to the query
   std::vector<std::uint64_t> ranked;  // (squared distance bits << 32) | candidate
   float previous_kth = 0;             // k-th squared distance of the previous query
-  static constexpr int kBuckets = 256;
+  static constexpr int kBuckets = 128;
   std::vector<std::uint32_t> within;     // candidates inside the bucket range
   std::vector<std::uint16_t> bucket_of;  // bucket of each of them
   std::array<std::uint32_t, kBuckets> bucket_start{};
