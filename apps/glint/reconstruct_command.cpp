@@ -93,7 +93,7 @@ struct ReconstructOptions {
   std::string views;     // TUM trajectory of extra poses to re-render at the end
   // The ray-cast normals of renderings are smoothed within this radius: the TSDF's surface
   // carries millimetre bumps from the depth quantisation that its per-pixel normals turn into
-  // speckled shading (4 voxels at 5 mm; chosen on cubes, see docs/reflectance/history.md).
+  // speckled shading (4 voxels at 5 mm; docs/decisions.md).
   float render_normal_radius_m = 0.02f;
   reflectance::ReflectanceParams params;
 };
