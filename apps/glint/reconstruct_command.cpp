@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/progress.h"
+#include "core/resources.h"
 #include "core/timer.h"
 #include "fusion/depth_maps.h"
 #include "fusion/marching_cubes.h"
@@ -159,9 +160,8 @@ void run_reconstruct(ReconstructOptions options) {
   const std::vector<io::StampedPose> views = options.views.empty()
                                                  ? std::vector<io::StampedPose>{}
                                                  : io::read_tum_trajectory(options.views);
-  const std::string model_path = options.model.empty()
-                                     ? (fs::path(models_directory()) / "hemicnn.json").string()
-                                     : options.model;
+  const std::string model_path =
+      options.model.empty() ? glint::model_path("hemicnn.json").string() : options.model;
   const reflectance::HemiCnn network = reflectance::HemiCnn::load(model_path);
 
   // Everything goes to a temporary folder renamed onto OUT at the end: a failure leaves no
