@@ -1,5 +1,5 @@
 // glint render: a scene.json rendered along its trajectory into an RGB-D sequence with ground
-// truth (README "Rendering (glint render)").
+// truth (docs/reflectance.md, "render").
 #include <fmt/format.h>
 
 #include <cmath>
@@ -73,7 +73,7 @@ void register_render_command(CLI::App& app) {
       "and clipped), depth/ (16-bit mm), associations.txt, groundtruth.txt (TUM),\n"
       "intrinsics.json, gt/ (depth, normal, segment, kd, ks, alpha) and scene.json.\n"
       "Direct light by default; --bounces N adds N bounces of path-traced indirect light\n"
-      "(docs/reflectance.md 'Rendering').");
+      "(docs/reflectance.md, 'render').");
   command->add_option("scene", options->scene_path, "Scene description (scene.json)")
       ->required()
       ->check(CLI::ExistingFile);
