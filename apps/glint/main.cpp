@@ -8,6 +8,7 @@
 
 #include "cli_support.h"
 #include "commands.h"
+#include "core/build_info.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/parallel.h"
@@ -31,7 +32,9 @@ int main(int argc, char** argv) {
       "denoising (denoise) and point-cloud edge/boundary detection (edges, BoundED).\n"
       "Run 'glint <command> --help' for the options of each command."};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "glint 0.1.0");
+  app.set_version_flag(
+      "--version", [] { return glint::describe_build(); },
+      "The version, the optional parts compiled in, where models and plugins are");
 
   glint::app::remember_command_line(argc, argv);
   glint::app::CommonOptions common;

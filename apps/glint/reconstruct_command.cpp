@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/progress.h"
+#include "core/resources.h"
 #include "core/timer.h"
 #include "fusion/marching_cubes.h"
 #include "io/image_io.h"
@@ -99,9 +100,8 @@ void run_reconstruct(ReconstructOptions options) {
   const std::vector<io::StampedPose> views = options.views.empty()
                                                  ? std::vector<io::StampedPose>{}
                                                  : io::read_tum_trajectory(options.views);
-  const std::string model_path = options.model.empty()
-                                     ? (fs::path(models_directory()) / "hemicnn.json").string()
-                                     : options.model;
+  const std::string model_path =
+      options.model.empty() ? glint::model_path("hemicnn.json").string() : options.model;
   const reflectance::HemiCnn network = reflectance::HemiCnn::load(model_path);
 
   // Everything goes to a temporary folder renamed onto OUT at the end: a failure leaves no
