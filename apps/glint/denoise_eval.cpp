@@ -181,9 +181,9 @@ void run_eval(const EvalOptions& options) {
         point["iteration"] = iteration;
         trace.push_back(std::move(point));
       };
-      const denoise::DenoiseRun run = denoise::run_denoiser(method, options.denoiser, noisy,
-                                          denoise::method_is_guided(method) ? &guidance : nullptr,
-                                          score_estimate, options.trace_every);
+      const denoise::DenoiseRun run = denoise::run_denoiser(
+          method, options.denoiser, noisy, denoise::method_is_guided(method) ? &guidance : nullptr,
+          score_estimate, options.trace_every);
       nlohmann::json values = quality(clean, run.result, mask, clean_mask);
       if (!trace.empty()) values["trace"] = trace;
       values["seconds"] = run.stats.seconds;

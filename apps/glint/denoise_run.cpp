@@ -52,8 +52,9 @@ void run_denoise(const RunOptions& options) {
                       estimate, depth);
     };
   }
-  const denoise::DenoiseRun run = denoise::run_denoiser(options.method, options.denoiser, noisy, guidance.empty() ? nullptr : &guidance,
-                   snapshot, options.snapshot_every);
+  const denoise::DenoiseRun run = denoise::run_denoiser(options.method, options.denoiser, noisy,
+                                                        guidance.empty() ? nullptr : &guidance,
+                                                        snapshot, options.snapshot_every);
   io::write_image(options.output, run.result, depth);
   log().info("{}: {} on {}, {} iterations, {:.1f} s -> {}", options.input, options.method,
              run.stats.device, run.stats.iterations, run.stats.seconds, options.output);

@@ -141,7 +141,8 @@ void run_reconstruct(ReconstructOptions options) {
       if (result.geometry.integrated && (evaluate || render)) {
         watch.restart();
         reflectance::render_model(pipeline, sequence.intrinsics, result.geometry.camera_to_world,
-                     options.render_normal_radius_m, render_timings, maps, &frame.depth_m);
+                                  options.render_normal_radius_m, render_timings, maps,
+                                  &frame.depth_m);
         command_timings.add("render", watch.elapsed_ms());
         watch.restart();
         if (evaluate) evaluation.add_frame(int(i), maps, *truth, frame.colour);
@@ -159,8 +160,8 @@ void run_reconstruct(ReconstructOptions options) {
     ProgressBar progress("views", views.size());
     for (std::size_t k = 0; k < views.size(); ++k) {
       Stopwatch watch;
-      reflectance::render_model(pipeline, sequence.intrinsics, views[k].pose, options.render_normal_radius_m,
-                   render_timings, maps);
+      reflectance::render_model(pipeline, sequence.intrinsics, views[k].pose,
+                                options.render_normal_radius_m, render_timings, maps);
       command_timings.add("render", watch.elapsed_ms());
       write_view_pictures((fs::path(staging) / "views").string(), int(k), maps);
       progress.advance();
@@ -172,8 +173,8 @@ void run_reconstruct(ReconstructOptions options) {
   reflectance::write_reconstruction(staging, pipeline, lights);
   command_timings.add("mesh", watch.elapsed_ms());
   if (has_truth && !evaluation.series().empty()) {
-    write_material_plots((fs::path(staging) / "materials-over-time.png").string(),
-                         evaluation, options.evaluate_every);
+    write_material_plots((fs::path(staging) / "materials-over-time.png").string(), evaluation,
+                         options.evaluate_every);
     print_evaluation_table(evaluation);
   }
 
@@ -189,7 +190,8 @@ void run_reconstruct(ReconstructOptions options) {
       timings.median_ms("specular"), timings.median_ms("albedo"), timings.median_ms("total"),
       options.output);
   const reflectance::SpecularParams& specular = options.params.specular;
-  const reflectance::MaterialCoverage coverage = reflectance::material_coverage(pipeline, specular.min_distinct_voxels);
+  const reflectance::MaterialCoverage coverage =
+      reflectance::material_coverage(pipeline, specular.min_distinct_voxels);
   if (coverage.without_material > 0) {
     const reflectance::ObservationGridParams& grid = options.params.observations;
     log().warn(

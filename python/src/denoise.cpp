@@ -1,11 +1,12 @@
 // glint.denoise: the noise-level map and guidance map, and the denoising methods of
 // `glint denoise noise-map` and `glint denoise run`, on NumPy images.
+#include <fmt/format.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <fmt/format.h>
-
 #include <algorithm>
+#include <functional>
+#include <map>
 
 #include "bindings.h"
 #include "core/error.h"
@@ -38,9 +39,48 @@ py::tuple noise_map(const py::object& image_arg, const std::string& method, int 
                         array_from_image(std::move(noise)), info);
 }
 
+// Sets `target` from a keyword value; None leaves it unset (the preset's value).
 template <class T>
-void set_optional(std::optional<T>& target, const py::object& value) {
+void set_optional(std::optional<T>& target, const py::handle& value) {
   if (!value.is_none()) target = value.cast<T>();
+}
+
+// The CLI's denoiser options by their Python names ('_' for '-'; --lr, --pd as they are).
+denoise::DenoiserSettings settings_from(const py::dict& options) {
+  denoise::DenoiserSettings s;
+  using Setter = std::function<void(const py::handle&)>;
+  const std::map<std::string, Setter> setters{
+      {"config", [&](const py::handle& v) { s.config = v.cast<std::string>(); }},
+      {"device", [&](const py::handle& v) { s.device = v.cast<std::string>(); }},
+      {"seed", [&](const py::handle& v) { s.seed = v.cast<std::uint64_t>(); }},
+      {"iterations", [&](const py::handle& v) { set_optional(s.iterations, v); }},
+      {"predictions", [&](const py::handle& v) { set_optional(s.predictions, v); }},
+      {"levels", [&](const py::handle& v) { set_optional(s.levels, v); }},
+      {"channels", [&](const py::handle& v) { set_optional(s.channels, v); }},
+      {"lr", [&](const py::handle& v) { set_optional(s.learning_rate, v); }},
+      {"input_noise", [&](const py::handle& v) { set_optional(s.input_noise, v); }},
+      {"average", [&](const py::handle& v) { set_optional(s.average, v); }},
+      {"pd", [&](const py::handle& v) { set_optional(s.discard, v); }},
+      {"dropout", [&](const py::handle& v) { set_optional(s.dropout, v); }},
+      {"kappa_w", [&](const py::handle& v) { set_optional(s.kappa_w, v); }},
+      {"kappa_r", [&](const py::handle& v) { set_optional(s.kappa_r, v); }},
+      {"kappa_c", [&](const py::handle& v) { set_optional(s.kappa_c, v); }},
+      {"kappa_m", [&](const py::handle& v) { set_optional(s.kappa_m, v); }},
+      {"nlm_h", [&](const py::handle& v) { s.nlm.h = v.cast<float>(); }},
+      {"noise_method", [&](const py::handle& v) { s.noise_method = v.cast<std::string>(); }},
+      {"patch", [&](const py::handle& v) { s.patch = v.cast<int>(); }}};
+  for (const auto& [key, value] : options) {
+    const std::string name = py::str(key);
+    const auto setter = setters.find(name);
+    if (setter == setters.end()) throw Error(name, "", "unknown option of glint.denoise.run");
+    setter->second(value);
+  }
+  // The CLI's choices (config is checked by the preset).
+  if (s.device != "auto" && s.device != "cpu" && s.device != "cuda")
+    throw Error("device", s.device, "must be auto, cpu or cuda");
+  if (s.noise_method != "svd" && s.noise_method != "var" && s.noise_method != "variance")
+    throw Error("noise_method", s.noise_method, "must be svd or var");
+  return s;
 }
 
 py::array run(const py::object& image_arg, const std::string& method,
@@ -48,30 +88,7 @@ py::array run(const py::object& image_arg, const std::string& method,
   const auto& names = denoise::denoise_method_names();
   if (std::find(names.begin(), names.end(), method) == names.end())
     throw Error("method", method, "unknown method (nlm, dip, guided-dip, s2s, guided-s2s)");
-  denoise::DenoiserSettings settings;
-  for (const auto& [key, value] : options) {
-    const std::string name = py::str(key);
-    if (name == "config") settings.config = value.cast<std::string>();
-    else if (name == "device") settings.device = value.cast<std::string>();
-    else if (name == "seed") settings.seed = value.cast<std::uint64_t>();
-    else if (name == "iterations") set_optional(settings.iterations, py::reinterpret_borrow<py::object>(value));
-    else if (name == "predictions") set_optional(settings.predictions, py::reinterpret_borrow<py::object>(value));
-    else if (name == "levels") set_optional(settings.levels, py::reinterpret_borrow<py::object>(value));
-    else if (name == "channels") set_optional(settings.channels, py::reinterpret_borrow<py::object>(value));
-    else if (name == "lr") set_optional(settings.learning_rate, py::reinterpret_borrow<py::object>(value));
-    else if (name == "input_noise") set_optional(settings.input_noise, py::reinterpret_borrow<py::object>(value));
-    else if (name == "average") set_optional(settings.average, py::reinterpret_borrow<py::object>(value));
-    else if (name == "pd") set_optional(settings.discard, py::reinterpret_borrow<py::object>(value));
-    else if (name == "dropout") set_optional(settings.dropout, py::reinterpret_borrow<py::object>(value));
-    else if (name == "kappa_w") set_optional(settings.kappa_w, py::reinterpret_borrow<py::object>(value));
-    else if (name == "kappa_r") set_optional(settings.kappa_r, py::reinterpret_borrow<py::object>(value));
-    else if (name == "kappa_c") set_optional(settings.kappa_c, py::reinterpret_borrow<py::object>(value));
-    else if (name == "kappa_m") set_optional(settings.kappa_m, py::reinterpret_borrow<py::object>(value));
-    else if (name == "nlm_h") settings.nlm.h = value.cast<float>();
-    else if (name == "noise_method") settings.noise_method = value.cast<std::string>();
-    else if (name == "patch") settings.patch = value.cast<int>();
-    else throw Error(name, "", "unknown option of glint.denoise.run");
-  }
+  const denoise::DenoiserSettings settings = settings_from(options);
   const ImageF noisy = image_from_array(image_arg, "image");
   ImageF guidance;
   const bool guided = denoise::method_is_guided(method);
@@ -91,8 +108,8 @@ py::array run(const py::object& image_arg, const std::string& method,
 }  // namespace
 
 void bind_denoise(py::module_ m) {
-  m.def("noise_map", &noise_map, py::arg("image"), py::arg("method") = "svd",
-        py::arg("patch") = 7, py::arg("bins") = 256, py::arg("upper_quantile") = 0.95,
+  m.def("noise_map", &noise_map, py::arg("image"), py::arg("method") = "svd", py::arg("patch") = 7,
+        py::arg("bins") = 256, py::arg("upper_quantile") = 0.95,
         R"(Per-pixel noise level and the guidance map made from it, as `glint denoise noise-map`.
 
 Args:

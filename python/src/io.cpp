@@ -1,9 +1,8 @@
 // glint.io: point clouds, images and RGB-D sequences to and from NumPy arrays, through glint's
 // own readers and writers (the ones the CLI uses).
+#include <fmt/format.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
-
-#include <fmt/format.h>
 
 #include <variant>
 
@@ -40,8 +39,8 @@ py::tuple read_point_cloud(const py::object& path_arg) {
   for (const NamedAttribute& attribute : cloud.attributes()) names.push_back(attribute.name);
   for (const std::string& name : names) {
     AttributeColumn column = *cloud.find(name);
-    fields[py::str(name)] = std::visit(
-        [](auto& values) { return array_from_vector(std::move(values)); }, column);
+    fields[py::str(name)] =
+        std::visit([](auto& values) { return array_from_vector(std::move(values)); }, column);
     cloud.remove(name);
   }
   return py::make_tuple(array_from_vector(std::move(xyz), {py::ssize_t(n), 3}), fields);
@@ -49,8 +48,7 @@ py::tuple read_point_cloud(const py::object& path_arg) {
 
 // A 1-D NumPy array of a PLY-representable dtype -> an attribute column (copied).
 AttributeColumn column_from(const py::handle& object, const std::string& name, std::size_t n) {
-  if (!py::isinstance<py::array>(object))
-    throw Error(name, "", "must be a 1-D NumPy array");
+  if (!py::isinstance<py::array>(object)) throw Error(name, "", "must be a 1-D NumPy array");
   const auto array = py::reinterpret_borrow<py::array>(object);
   if (array.ndim() != 1 || std::size_t(array.shape(0)) != n)
     throw Error(name, "", fmt::format("must be a 1-D array of {} values (one per point)", n));
@@ -71,9 +69,8 @@ AttributeColumn column_from(const py::handle& object, const std::string& name, s
                           std::string(py::str(array.dtype()))));
 }
 
-void write_point_cloud(const py::object& path_arg, const py::object& xyz,
-                       const py::object& labels, const py::object& probs,
-                       const py::object& fields) {
+void write_point_cloud(const py::object& path_arg, const py::object& xyz, const py::object& labels,
+                       const py::object& probs, const py::object& fields) {
   const std::string path = path_from(path_arg);
   PointCloud cloud = cloud_from_array(xyz, "xyz");
   if (!fields.is_none())
@@ -225,8 +222,8 @@ depth (H, W) float32 metres (0 = none), pose (4, 4) camera-to-world float64 or N
 segments (H, W) int32 ground-truth segment ids or None, timestamp (s), index.)")
       .def_property_readonly("folder", [](const Sequence& s) { return s.sequence.folder; })
       .def_property_readonly("format", [](const Sequence& s) { return s.sequence.format; })
-      .def_property_readonly("intrinsics",
-                             [](const Sequence& s) { return intrinsics_dict(s.sequence.intrinsics); })
+      .def_property_readonly(
+          "intrinsics", [](const Sequence& s) { return intrinsics_dict(s.sequence.intrinsics); })
       .def_property_readonly("exposure", [](const Sequence& s) { return s.exposure; })
       .def("__len__", [](const Sequence& s) { return s.sequence.frames.size(); })
       .def("__getitem__", &read_frame, py::arg("index"));

@@ -80,9 +80,9 @@ void fill_image(const py::array& array, ImageF& image, double scale) {
 PointCloud cloud_from_array(const py::handle& object, const std::string& name) {
   const py::array array = as_array(object, name);
   if (array.ndim() != 2 || array.shape(1) != 3)
-    throw Error(name, "",
-                fmt::format("must be an (N, 3) array of positions, got shape {}",
-                            shape_text(array)));
+    throw Error(
+        name, "",
+        fmt::format("must be an (N, 3) array of positions, got shape {}", shape_text(array)));
   PointCloud cloud;
   cloud.resize(std::size_t(array.shape(0)));
   if (holds<float>(array))
@@ -90,18 +90,18 @@ PointCloud cloud_from_array(const py::handle& object, const std::string& name) {
   else if (holds<double>(array))
     fill_cloud<double>(array, cloud, name);
   else
-    throw Error(name, "",
-                fmt::format("must be float32 or float64, got {}",
-                            std::string(py::str(array.dtype()))));
+    throw Error(
+        name, "",
+        fmt::format("must be float32 or float64, got {}", std::string(py::str(array.dtype()))));
   return cloud;
 }
 
 ImageF image_from_array(const py::handle& object, const std::string& name) {
   const py::array array = as_array(object, name);
   if (array.ndim() != 2 && array.ndim() != 3)
-    throw Error(name, "",
-                fmt::format("must be an (H, W) or (H, W, C) image, got shape {}",
-                            shape_text(array)));
+    throw Error(
+        name, "",
+        fmt::format("must be an (H, W) or (H, W, C) image, got shape {}", shape_text(array)));
   const py::ssize_t height = array.shape(0), width = array.shape(1),
                     channels = array.ndim() == 3 ? array.shape(2) : 1;
   if (height == 0 || width == 0 || channels == 0)
@@ -128,7 +128,8 @@ Image<std::int32_t> labels_from_array(const py::handle& object, const std::strin
     throw Error(name, "",
                 fmt::format("must be an (H, W) integer array, got shape {} of {}",
                             shape_text(array), std::string(py::str(array.dtype()))));
-  const auto converted = py::array_t<std::int32_t, py::array::c_style | py::array::forcecast>(array);
+  const auto converted =
+      py::array_t<std::int32_t, py::array::c_style | py::array::forcecast>(array);
   Image<std::int32_t> labels(int(array.shape(1)), int(array.shape(0)), 1);
   std::copy_n(converted.data(), labels.values().size(), labels.values().data());
   return labels;
@@ -138,8 +139,8 @@ std::vector<double> matrix_from_array(const py::handle& object, int rows, int co
                                       const std::string& name) {
   const auto array = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(object);
   const bool vector = rows == 1 && array && array.ndim() == 1 && array.shape(0) == cols;
-  if (!array || (!vector && (array.ndim() != 2 || array.shape(0) != rows ||
-                             array.shape(1) != cols)))
+  if (!array ||
+      (!vector && (array.ndim() != 2 || array.shape(0) != rows || array.shape(1) != cols)))
     throw Error(name, "", fmt::format("must be a {}x{} array of numbers", rows, cols));
   std::vector<double> values(array.data(), array.data() + std::size_t(rows) * cols);
   for (double v : values)
@@ -154,8 +155,8 @@ py::array array_from_image(ImageF&& image) {
   const py::ssize_t item = sizeof(float);
   if (channels == 1)
     return py::array_t<float>({height, width}, {width * item, item}, owned->plane(0), owner);
-  return py::array_t<float>({height, width, channels},
-                            {width * item, item, height * width * item}, owned->plane(0), owner);
+  return py::array_t<float>({height, width, channels}, {width * item, item, height * width * item},
+                            owned->plane(0), owner);
 }
 
 py::array array_from_image(Image<std::int32_t>&& image) {

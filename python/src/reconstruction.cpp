@@ -1,16 +1,15 @@
 // glint.Reconstruction: the online reflectance pipeline of `glint reconstruct` (paper 1), fed
 // frame by frame from NumPy arrays.
+#include <fmt/format.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
-
-#include <fmt/format.h>
 
 #include <memory>
 #include <mutex>
 
 #include "bindings.h"
-#include "core/resources.h"
 #include "core/error.h"
+#include "core/resources.h"
 #include "numpy_support.h"
 #include "reflectance/albedo_refinement.h"
 #include "reflectance/hemicnn.h"
@@ -55,8 +54,10 @@ reflectance::LightEstimate lights_from(const py::handle& object) {
     if (!d.contains("position") || !d.contains("intensity"))
       throw Error("lights", element, "needs position and intensity");
     render::PointLight light;
-    const auto position = matrix_from_array(d["position"], 1, 3, "lights: " + element + ": position");
-    const auto intensity = matrix_from_array(d["intensity"], 1, 3, "lights: " + element + ": intensity");
+    const auto position =
+        matrix_from_array(d["position"], 1, 3, "lights: " + element + ": position");
+    const auto intensity =
+        matrix_from_array(d["intensity"], 1, 3, "lights: " + element + ": intensity");
     light.position = {position[0], position[1], position[2]};
     light.intensity = Eigen::Vector3d(intensity[0], intensity[1], intensity[2]).cast<float>();
     if (d.contains("radius_m")) light.proxy_radius_m = d["radius_m"].cast<double>();
@@ -108,7 +109,8 @@ reflectance::ReflectanceParams params_from(const py::dict& options, std::string&
     } else if (name == "obs_voxel") {
       p.observations.voxel_size_m = float(positive(value.cast<double>()));
     } else if (name == "obs_voxels") {
-      if (!value.is_none()) p.observations.voxel_capacity = std::size_t(positive(value.cast<double>()));
+      if (!value.is_none())
+        p.observations.voxel_capacity = std::size_t(positive(value.cast<double>()));
     } else if (name == "obs_spacing") {
       p.observations.min_observation_spacing_deg = value.cast<float>();
     } else if (name == "obs_spacing_frames") {
@@ -295,7 +297,8 @@ class Reconstruction {
   py::dict timings() {
     std::lock_guard lock(mutex_);
     py::dict d;
-    for (const char* stage : {"geometry", "observations", "segmentation", "specular", "albedo", "total"})
+    for (const char* stage :
+         {"geometry", "observations", "segmentation", "specular", "albedo", "total"})
       d[stage] = pipeline_->timings().median_ms(stage);
     return d;
   }

@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/progress.h"
+#include "core/resources.h"
 #include "denoise/denoise_plugin.h"
 
 namespace glint::denoise {
@@ -77,8 +78,8 @@ DenoiseRun run_denoiser(const std::string& method, const DenoiserSettings& setti
   NeuralParams params = settings.neural_params(parse_neural_method(method));
   params.snapshot = snapshot;
   params.snapshot_every = snapshot_every;
-  const auto entry = reinterpret_cast<DenoisePluginEntry>(
-      plugin_entry(kDenoisePlugin, kDenoisePluginEntry));
+  const auto entry =
+      reinterpret_cast<DenoisePluginEntry>(plugin_entry(kDenoisePlugin, kDenoisePluginEntry));
   DenoisePluginCall call;
   call.noisy = &noisy;
   call.guidance = guidance;

@@ -49,8 +49,8 @@ void render_model(const ReflectancePipeline& pipeline, const Intrinsics& intrins
     timings.add("smooth_normals", watch.elapsed_ms());
   }
   watch.restart();
-  render_material_maps(view, pose, pipeline.observations(), pipeline.materials(),
-                       pipeline.lights(), pipeline.exposure(), pipeline.albedo_blend(), maps);
+  render_material_maps(view, pose, pipeline.observations(), pipeline.materials(), pipeline.lights(),
+                       pipeline.exposure(), pipeline.albedo_blend(), maps);
   timings.add("shade", watch.elapsed_ms());
 }
 
