@@ -176,9 +176,9 @@ void bind_io(py::module_ m) {
         R"(Read a point cloud (.ply, .xyz/.pts/.txt/.csv, .pcd) with glint's readers.
 
 Returns:
-    (xyz, fields): xyz (N, 3) float32 positions (copied out of glint's per-axis arrays);
+    (xyz, fields): xyz (N, 3) float32 positions (interleaved from glint's per-axis arrays);
     fields: dict of the per-point properties by name (e.g. 'scalar_label', 'red'), each a
-    1-D array of the stored type, moved out without a copy.
+    1-D array of the stored type (copied).
 
 Raises:
     glint.Error: unknown extension, missing or malformed file, non-finite coordinates.)");
