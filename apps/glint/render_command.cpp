@@ -1,5 +1,5 @@
 // glint render: a scene.json rendered along its trajectory into an RGB-D sequence with ground
-// truth (README "Rendering (glint render)").
+// truth (docs/reflectance.md, "render").
 #include <fmt/format.h>
 
 #include <cmath>
@@ -67,7 +67,7 @@ void register_render_command(CLI::App& app) {
       "environment, camera and trajectory) into an RGB-D sequence: rgb/ (8-bit sRGB, exposed\n"
       "and clipped), depth/ (16-bit mm), associations.txt, groundtruth.txt (TUM),\n"
       "intrinsics.json, gt/ (depth, normal, segment, kd, ks, alpha) and scene.json.\n"
-      "Direct lighting only (no interreflections); see README 'Rendering (glint render)'.");
+      "Direct lighting only (no interreflections); see docs/reflectance.md.");
   command->add_option("scene", options->scene_path, "Scene description (scene.json)")
       ->required()
       ->check(CLI::ExistingFile);

@@ -21,7 +21,7 @@ LightEstimate load_lights(const std::string& source);
 
 // Re-renderings smooth the ray-cast normals within this radius: the TSDF's surface carries
 // millimetre bumps from the depth quantisation that per-pixel normals turn into speckled
-// shading (4 voxels at 5 mm; chosen on cubes).
+// shading (4 voxels at 5 mm; docs/decisions.md).
 inline constexpr float kRenderNormalRadiusM = 0.02f;
 
 // The model re-rendered from `pose` (camera-to-world) into `maps`: ray cast (gradient normals),

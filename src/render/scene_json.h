@@ -1,5 +1,5 @@
 #pragma once
-// scene.json <-> render::Scene. The format (README "Rendering (glint render)" documents it):
+// scene.json <-> render::Scene. The format (docs/reflectance.md, "scene.json", documents it):
 //   {
 //     "objects": [{"name", "id", "shape": "mesh|box|sphere|plane", "mesh": "bunny.obj",
 //                  "size": [x, y, z],
