@@ -15,17 +15,15 @@ std::vector<int> scales_from(const py::object& scales) {
   return scales.is_none() ? std::vector<int>{} : scales.cast<std::vector<int>>();
 }
 
-py::tuple classify(const py::object& xyz, const py::object& model_path,
-                   const py::object& scales_arg) {
+py::tuple classify(const py::object& xyz, const py::object& model, const py::object& scales_arg) {
   const std::vector<int> scales = scales_from(scales_arg);
   const std::string path =
-      model_path.is_none() ? model_path("bounded-3c.json").string() : path_from(model_path);
+      model.is_none() ? model_path("bounded-3c.json").string() : path_from(model);
   PointCloud cloud = cloud_from_array(xyz, "xyz");
   edges::Classification result;
   {
     py::gil_scoped_release release;
-    const edges::Model model = edges::Model::load(path);
-    result = edges::classify(cloud, model, scales);
+    result = edges::classify(cloud, edges::Model::load(path), scales);
   }
   // probs: (N, 2), columns p_sharp and p_boundary, interleaved here (one pass over 8 N bytes).
   const std::size_t n = result.labels.size();

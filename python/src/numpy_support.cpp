@@ -60,8 +60,10 @@ void fill_cloud(const py::array& array, PointCloud& cloud, const std::string& na
   if (bad < n) throw Error(name, fmt::format("row {}", bad), "non-finite coordinate");
 }
 
+// Samples times `scale` in float arithmetic, as io::read_image's OpenCV conversion does, so an
+// integer array gives the values its PNG would.
 template <class T>
-void fill_image(const py::array& array, ImageF& image, double scale) {
+void fill_image(const py::array& array, ImageF& image, float scale) {
   const auto* base = static_cast<const char*>(array.data());
   const py::ssize_t strides[3] = {array.strides(0), array.strides(1),
                                   array.ndim() == 3 ? array.strides(2) : 0};
@@ -71,7 +73,7 @@ void fill_image(const py::array& array, ImageF& image, double scale) {
     for (int y = 0; y < image.height(); ++y)
       for (int x = 0; x < image.width(); ++x)
         plane[std::size_t(y) * image.width() + x] =
-            float(double(element<T>(base, strides, y, x, c)) * scale);
+            static_cast<float>(element<T>(base, strides, y, x, c)) * scale;
   }
 }
 
@@ -108,13 +110,13 @@ ImageF image_from_array(const py::handle& object, const std::string& name) {
     throw Error(name, "", fmt::format("has no pixels (shape {})", shape_text(array)));
   ImageF image(static_cast<int>(width), static_cast<int>(height), static_cast<int>(channels));
   if (holds<float>(array))
-    fill_image<float>(array, image, 1.0);
+    fill_image<float>(array, image, 1.0f);
   else if (holds<double>(array))
-    fill_image<double>(array, image, 1.0);
+    fill_image<double>(array, image, 1.0f);
   else if (holds<std::uint8_t>(array))
-    fill_image<std::uint8_t>(array, image, 1.0 / 255.0);
+    fill_image<std::uint8_t>(array, image, static_cast<float>(1.0 / 255.0));
   else if (holds<std::uint16_t>(array))
-    fill_image<std::uint16_t>(array, image, 1.0 / 65535.0);
+    fill_image<std::uint16_t>(array, image, static_cast<float>(1.0 / 65535.0));
   else
     throw Error(name, "",
                 fmt::format("must be float32, float64, uint8 or uint16, got {}",
