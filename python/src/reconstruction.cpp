@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <mutex>
+#include <optional>
 
 #include "bindings.h"
 #include "core/error.h"
@@ -273,13 +274,16 @@ class Reconstruction {
     return d;
   }
 
-  reflectance::MaterialMaps render_maps(const py::object& pose_arg) {
+  reflectance::MaterialMaps render_maps(const py::object& pose_arg, const py::object& depth_arg) {
     const Pose pose = pose_from(pose_arg, "pose");
+    std::optional<ImageF> depth;
+    if (!depth_arg.is_none()) depth = image_from_array(depth_arg, "depth");
     reflectance::MaterialMaps maps;
     py::gil_scoped_release release;
     std::lock_guard lock(mutex_);
     StageTimings timings;
-    reflectance::render_model(*pipeline_, intrinsics_, pose, render_normal_radius_, timings, maps);
+    reflectance::render_model(*pipeline_, intrinsics_, pose, render_normal_radius_, timings, maps,
+                              depth ? &*depth : nullptr);
     return maps;
   }
 
@@ -378,20 +382,23 @@ Returns:
     faces and colours own the C++ arrays (no copy); kd/ks are interleaved copies.)")
       .def(
           "render",
-          [](Reconstruction& self, const py::object& pose) {
-            return array_from_image(std::move(self.render_maps(pose).rgb_refined));
+          [](Reconstruction& self, const py::object& pose, const py::object& depth) {
+            return array_from_image(std::move(self.render_maps(pose, depth).rgb_refined));
           },
-          py::arg("pose"),
+          py::arg("pose"), py::arg("depth") = py::none(),
           R"(Re-render the model from a (4, 4) camera-to-world pose with the estimated
 materials, refined albedo and lights: (H, W, 3) float32 linear RGB (radiance x exposure,
-clipped to [0, 1]), what OUT/frames/*-render.png shows. A view of the image; no copy.)")
+clipped to [0, 1]), what OUT/frames/*-render.png shows. A view of the image; no copy.
+depth: optionally the (H, W) depth in metres of a frame fused from that pose, which the ray
+cast starts from, as the CLI's per-frame re-renderings do (without it the ray cast starts at
+the camera, and the surface found differs slightly).)")
       .def(
           "render_maps",
-          [](Reconstruction& self, const py::object& pose) {
-            return maps_dict(self.render_maps(pose));
+          [](Reconstruction& self, const py::object& pose, const py::object& depth) {
+            return maps_dict(self.render_maps(pose, depth));
           },
-          py::arg("pose"),
-          R"(All maps of a re-rendering: dict rgb_refined, rgb (HemiCNN kd), kd_refined, kd, ks
+          py::arg("pose"), py::arg("depth") = py::none(),
+          R"(All maps of a re-rendering (pose and depth as render()): dict rgb_refined, rgb (HemiCNN kd), kd_refined, kd, ks
 ((H, W, 3)), alpha, covered ((H, W) float32), segment ((H, W) int32).)")
       .def("export", &Reconstruction::export_to, py::arg("path"),
            R"(Write OUT/mesh.ply, OUT/materials.json and OUT/lights.json as `glint reconstruct`
