@@ -80,28 +80,31 @@ int main(int argc, char** argv) {
   report["generated"]["covariance_baseline_s"] = watch.elapsed_s();
 
   // The peer for the neighbourhood search: nanoflann (via glint's KdTree) answering k = 128
-  // queries for every point in parallel, results discarded (BoundED's search hands each list
-  // to the features instead of storing 1M × 128 of them).
+  // queries in parallel, results discarded (BoundED's search hands each list to the features
+  // instead of storing 1M × 128 of them). Every 10th point is queried: the rate is the same and
+  // the run stays short.
   {
     constexpr int k = 128;
+    constexpr std::size_t stride = 10;
+    const std::size_t queries = points / stride;
     const glint::Stopwatch build_watch;
     const glint::geometry::KdTree tree(cloud);
     const double build_s = build_watch.elapsed_s();
     const glint::Stopwatch query_watch;
-    glint::parallel_for_chunks(points, 1024, [&](std::size_t begin, std::size_t end) {
+    glint::parallel_for_chunks(queries, 256, [&](std::size_t begin, std::size_t end) {
       std::vector<std::uint32_t> indices(k);
       std::vector<float> distances(k);
-      for (std::size_t i = begin; i < end; ++i) {
+      for (std::size_t q = begin; q < end; ++q) {
+        const std::size_t i = q * stride;
         const float query[3] = {cloud.x[i], cloud.y[i], cloud.z[i]};
         tree.knn(query, k, indices.data(), distances.data());
       }
     });
     const double query_s = query_watch.elapsed_s();
-    report["nanoflann_knn128"] = {
-        {"build_s", build_s},
-        {"query_s", query_s},
-        {"queries_per_s", double(points) / query_s},
-        {"with_build_points_per_s", double(points) / (build_s + query_s)}};
+    report["nanoflann_knn128"] = {{"queries", queries},
+                                  {"build_s", build_s},
+                                  {"query_s", query_s},
+                                  {"queries_per_s", double(queries) / query_s}};
   }
 
   if (std::filesystem::is_directory(folder)) {
