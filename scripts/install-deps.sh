@@ -13,6 +13,8 @@ packages=(
   libembree-dev libtinyobjloader-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  # make package: CPack's .deb finds its shared-library dependencies with dpkg-shlibdeps and file.
+  dpkg-dev file
 )
 if [[ "${1:-}" == "--peers" ]]; then
   # libopenmpi-dev: Debian's PCL loads VTK, whose CMake package needs MPI's C target.

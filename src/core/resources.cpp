@@ -80,7 +80,7 @@ fs::path models_directory() {
   std::vector<std::string> searched;
   const fs::path found = find_below_prefixes(fs::path("share") / "glint" / "models", searched);
   if (found.empty())
-    throw Error("models", "",
+    throw Error("", "",
                 "no models folder found (set GLINT_MODELS_DIR); searched " + join(searched));
   return found;
 }
@@ -96,7 +96,7 @@ fs::path plugin_directory() {
   std::vector<std::string> searched;
   const fs::path found = find_below_prefixes(fs::path("lib") / "glint", searched);
   if (found.empty())
-    throw Error("plugins", "",
+    throw Error("", "",
                 "no plugin folder found (set GLINT_PLUGIN_DIR); searched " + join(searched));
   return found;
 }
