@@ -8,6 +8,7 @@
 
 #include "cli_support.h"
 #include "commands.h"
+#include "core/distributed.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/parallel.h"
@@ -31,7 +32,7 @@ int main(int argc, char** argv) {
       "denoising (denoise) and point-cloud edge/boundary detection (edges, BoundED).\n"
       "Run 'glint <command> --help' for the options of each command."};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "glint 0.1.0");
+  app.set_version_flag("--version", "glint 0.1.0\n" + glint::mpi_build_description());
 
   glint::app::remember_command_line(argc, argv);
   glint::app::CommonOptions common;
@@ -57,6 +58,7 @@ int main(int argc, char** argv) {
   });
 
   try {
+    glint::refuse_mpi_launch_without_mpi();
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
