@@ -20,7 +20,8 @@ namespace {
 constexpr std::size_t kBlockPoints = 1 << 20;
 constexpr double kScale = 0.001;
 constexpr double kOffset[3] = {500000.0, 5500000.0, 0.0};
-constexpr double kPartShare = 0.35;  // share of points on the shapes
+constexpr double kPartShare = 0.35;                // share of points on the shapes
+constexpr std::uint64_t kMeanShapePoints = 78000;  // mean of log-uniform 20k..200k
 
 double ground_height(double x, double y) {
   return 3.0 * std::sin(x / 90.0) + 2.0 * std::cos(y / 70.0) + 0.5 * std::sin((x + y) / 23.0);
@@ -78,10 +79,10 @@ int main(int argc, char** argv) {
     std::uint64_t planned = 0, index = 0;
     while (planned < part_budget) {
       parts.push_back({index++, uniform(rng) * side, uniform(rng) * side});
-      planned += 110000;  // the mean of the log-uniform 20k..200k, about
+      planned += kMeanShapePoints;
     }
   }
-  const std::uint64_t part_points_estimate = parts.size() * 110000;
+  const std::uint64_t part_points_estimate = parts.size() * kMeanShapePoints;
   const std::uint64_t ground_points =
       points > part_points_estimate ? points - part_points_estimate : points / 2;
   const std::uint64_t ground_blocks = (ground_points + kBlockPoints - 1) / kBlockPoints;

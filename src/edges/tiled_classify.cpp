@@ -435,8 +435,9 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
   std::int64_t side = std::max(grid.dims[0], grid.dims[1]);
   std::uint64_t largest = 0;
   Tiling tiling = make_tiling(grid, halos, sums, side, header.scale, largest);
-  while ((largest > tile_limit || (ranks > 1 && tiling.count() < std::size_t(2 * ranks))) &&
-         side > 1) {
+  // The tiling depends on the cloud and the limit only, never on the rank count, so any
+  // number of ranks writes the same bytes.
+  while (largest > tile_limit && side > 1) {
     side = std::max<std::int64_t>(1, std::min(side - 1, std::int64_t(double(side) * 0.85)));
     tiling = make_tiling(grid, halos, sums, side, header.scale, largest);
   }
