@@ -13,6 +13,8 @@ packages=(
   libembree-dev libtinyobjloader-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  # The optional MPI build (-DGLINT_WITH_MPI=ON) and the MPI test, which runs mpirun.
+  libopenmpi-dev openmpi-bin
 )
 if [[ "${1:-}" == "--peers" ]]; then
   packages+=(libopen3d-dev libpcl-dev libcgal-dev)

@@ -77,8 +77,8 @@ struct CountGrid {
 
 CountGrid make_count_grid(const std::int64_t low[3], const std::int64_t high[3],
                           const double scale[3], std::uint64_t points) {
-  // About one cell per point at most: finer cells would mostly be empty.
-  const std::uint64_t max_cells = std::clamp<std::uint64_t>(points, 4096, kMaxCountCells);
+  // Eight cells per point at most: finer cells would mostly be empty (a surface fills few).
+  const std::uint64_t max_cells = std::clamp<std::uint64_t>(8 * points, 4096, kMaxCountCells);
   CountGrid grid;
   double extent_m[3], volume = 1;
   for (int a = 0; a < 3; ++a) {

@@ -131,11 +131,11 @@ TEST_F(TiledClassify, TilesGiveTheWholeCloudsLabelsPointForPoint) {
       classify_las(path("scene.las"), path("whole.las"), bounded_model());
   EXPECT_FALSE(whole.tiled);
   TiledClassifyParams params;
-  params.tile_points = 4000;
+  params.tile_points = 6000;
   const TiledClassifyStats tiled =
       classify_las(path("scene.las"), path("tiled.las"), bounded_model(), params);
   EXPECT_TRUE(tiled.tiled);
-  EXPECT_GT(tiled.tiles, 2u);
+  EXPECT_GE(tiled.tiles, 2u);
   EXPECT_GT(tiled.halo_points, 0u);
   EXPECT_GT(tiled.labels[1] + tiled.labels[2], 0u);  // the shapes have edges
   const OutputDifference difference = compare_outputs(path("whole.las"), path("tiled.las"));
@@ -207,7 +207,7 @@ TEST_F(TiledClassify, MpiRanksWriteTheSingleProcessOutput) {
   const double origin[3] = {0, 0, 0};
   write_scene(path("scene.las"), origin);
   TiledClassifyParams params;
-  params.tile_points = 4000;
+  params.tile_points = 6000;
   classify_las(path("scene.las"), path("single.las"), bounded_model(), params);
   const std::string mpirun =
       "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
@@ -216,7 +216,7 @@ TEST_F(TiledClassify, MpiRanksWriteTheSingleProcessOutput) {
   const std::string log = path("mpirun.log");
   const int status = std::system((mpirun + GLINT_BINARY + " --quiet --threads 1 edges classify " +
                                   path("scene.las") + " -o " + path("mpi.las") +
-                                  " --tile-points 4000 > " + log + " 2>&1")
+                                  " --tile-points 6000 > " + log + " 2>&1")
                                      .c_str());
   std::ifstream stream(log);
   const std::string output{std::istreambuf_iterator<char>(stream), {}};
