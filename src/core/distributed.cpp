@@ -79,15 +79,6 @@ void Distributed::abort(int code) {
   std::exit(code);
 }
 
-std::string mpi_build_description() {
-  char version[MPI_MAX_LIBRARY_VERSION_STRING] = {};
-  int length = 0;
-  MPI_Get_library_version(version, &length);
-  std::string library(version, static_cast<std::size_t>(length));
-  library = library.substr(0, library.find(','));
-  return "MPI: yes (" + library + ")";
-}
-
 void refuse_mpi_launch_without_mpi() {}
 
 #else
@@ -99,18 +90,6 @@ void Distributed::min(std::vector<std::int64_t>&) {}
 void Distributed::max(std::vector<std::int64_t>&) {}
 void Distributed::max(std::vector<double>&) {}
 void Distributed::abort(int code) { std::exit(code); }
-
-std::string mpi_build_description() { return "MPI: no (build with -DGLINT_WITH_MPI=ON)"; }
-
-void refuse_mpi_launch_without_mpi() {
-  const int size = launcher_world_size();
-  if (size > 1) {
-    throw Error("mpirun", "",
-                "started " + std::to_string(size) +
-                    " copies of a glint built without MPI; each would do the whole job alone. "
-                    "Run it once without mpirun, or build with -DGLINT_WITH_MPI=ON");
-  }
-}
 
 #endif
 

@@ -3,7 +3,6 @@
 // by mpirun, otherwise a single process. Collective calls must be made by every rank in the
 // same order (MPI semantics); in a single process they return at once.
 #include <cstdint>
-#include <string>
 #include <vector>
 
 namespace glint {
@@ -32,10 +31,6 @@ class Distributed {
   int rank_ = 0;
   int size_ = 1;
 };
-
-// Whether this glint was built with MPI ("MPI: yes (Open MPI v4.1.4)" / "MPI: no") for
-// `glint --version`.
-std::string mpi_build_description();
 
 // Number of processes the launcher started, from its environment (OMPI_COMM_WORLD_SIZE,
 // PMI_SIZE, PMIX_SIZE); 1 when not started by one.
