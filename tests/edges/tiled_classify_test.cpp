@@ -34,7 +34,7 @@ std::vector<std::uint8_t> file_bytes(const std::string& path) {
   return {std::istreambuf_iterator<char>(stream), {}};
 }
 
-// Three synthetic shapes in a row on a ground plane, quantised to 0.1 mm, LAS 1.2 format 1.
+// Three synthetic shapes 10 m apart on a ground strip, quantised to 0.1 mm, LAS 1.2 format 1.
 void write_scene(const std::string& path, const double offset[3]) {
   SynthParams synth;
   synth.seed = 4;
@@ -53,13 +53,13 @@ void write_scene(const std::string& path, const double offset[3]) {
     }
     const double size = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
     for (std::size_t i = 0; i < cloud.size(); ++i) {
-      points.push_back({4.0 * s + 2.0 * (cloud.x[i] - lo[0]) / size,
+      points.push_back({10.0 * s + 2.0 * (cloud.x[i] - lo[0]) / size,
                         2.0 * (cloud.y[i] - lo[1]) / size, 2.0 * (cloud.z[i] - lo[2]) / size});
     }
   }
   std::mt19937_64 rng(9);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  for (int i = 0; i < 3000; ++i) points.push_back({-1 + 12 * u(rng), -1 + 4 * u(rng), -0.2});
+  for (int i = 0; i < 6000; ++i) points.push_back({-1 + 32 * u(rng), -1 + 4 * u(rng), -0.2});
 
   const double scale[3] = {1e-4, 1e-4, 1e-4};
   std::vector<std::uint8_t> records(points.size() * 28, 0);
@@ -131,7 +131,7 @@ TEST_F(TiledClassify, TilesGiveTheWholeCloudsLabelsPointForPoint) {
       classify_las(path("scene.las"), path("whole.las"), bounded_model());
   EXPECT_FALSE(whole.tiled);
   TiledClassifyParams params;
-  params.tile_points = 6000;
+  params.tile_points = 9000;
   const TiledClassifyStats tiled =
       classify_las(path("scene.las"), path("tiled.las"), bounded_model(), params);
   EXPECT_TRUE(tiled.tiled);
@@ -207,7 +207,7 @@ TEST_F(TiledClassify, MpiRanksWriteTheSingleProcessOutput) {
   const double origin[3] = {0, 0, 0};
   write_scene(path("scene.las"), origin);
   TiledClassifyParams params;
-  params.tile_points = 6000;
+  params.tile_points = 9000;
   classify_las(path("scene.las"), path("single.las"), bounded_model(), params);
   const std::string mpirun =
       "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
@@ -216,7 +216,7 @@ TEST_F(TiledClassify, MpiRanksWriteTheSingleProcessOutput) {
   const std::string log = path("mpirun.log");
   const int status = std::system((mpirun + GLINT_BINARY + " --quiet --threads 1 edges classify " +
                                   path("scene.las") + " -o " + path("mpi.las") +
-                                  " --tile-points 6000 > " + log + " 2>&1")
+                                  " --tile-points 9000 > " + log + " 2>&1")
                                      .c_str());
   std::ifstream stream(log);
   const std::string output{std::istreambuf_iterator<char>(stream), {}};
