@@ -91,6 +91,16 @@ void Distributed::max(std::vector<std::int64_t>&) {}
 void Distributed::max(std::vector<double>&) {}
 void Distributed::abort(int code) { std::exit(code); }
 
+void refuse_mpi_launch_without_mpi() {
+  const int size = launcher_world_size();
+  if (size > 1) {
+    throw Error("mpirun", "",
+                "started " + std::to_string(size) +
+                    " copies of a glint built without MPI; each would do the whole job alone. "
+                    "Run it once without mpirun, or build with -DGLINT_WITH_MPI=ON");
+  }
+}
+
 #endif
 
 Distributed& Distributed::world() {
