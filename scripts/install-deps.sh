@@ -17,6 +17,8 @@ packages=(
   python3-dev python3-numpy python3-pybind11 pybind11-dev python3-pytest python3-matplotlib
   # make package: CPack's .deb finds its shared-library dependencies with dpkg-shlibdeps and file.
   dpkg-dev file
+  # The optional MPI build (-DGLINT_WITH_MPI=ON) and the MPI test, which runs mpirun.
+  libopenmpi-dev openmpi-bin
 )
 if [[ "${1:-}" == "--peers" ]]; then
   # libopenmpi-dev: Debian's PCL loads VTK, whose CMake package needs MPI's C target.

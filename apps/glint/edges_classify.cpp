@@ -5,11 +5,13 @@
 
 #include "cli_support.h"
 #include "commands.h"
+#include "core/distributed.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/timer.h"
 #include "edges/angle_gap_baseline.h"
 #include "edges/classifier.h"
+#include "edges/tiled_classify.h"
 #include "io/json_report.h"
 #include "io/ply.h"
 #include "io/point_cloud_io.h"
@@ -26,6 +28,8 @@ struct ClassifyOptions {
   std::string report;
   std::vector<int> scales;
   std::string method = "bounded";
+  std::string memory_limit;
+  std::uint64_t tile_points = 0;
 };
 
 // The angle-gap baseline as a Classification: labels 0 / 2, p_boundary 0 / 1, no sharp class.
@@ -40,7 +44,99 @@ edges::Classification classify_angle_gap(const PointCloud& cloud) {
   return result;
 }
 
+bool is_las(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return extension == ".las" || extension == ".laz";
+}
+
+// LAS in, LAS out: streamed, tiled when the cloud exceeds the memory limit, spread over the
+// ranks of mpirun when built with MPI.
+void run_classify_las(const ClassifyOptions& options) {
+  if (!is_las(options.output)) {
+    throw Error(options.output, "", "a LAS input is written back as a .las file");
+  }
+  if (!options.png.empty()) {
+    throw Error(options.output, "--png", "is not available for LAS input (use a PLY cloud)");
+  }
+  if (options.method != "bounded") {
+    throw Error(options.input, "--method",
+                "only the network classifies LAS input (use a PLY cloud)");
+  }
+  const std::string model_path = options.model.empty() ? default_edges_model() : options.model;
+  const edges::Model model = edges::Model::load(model_path);
+  edges::TiledClassifyParams params;
+  params.scales = options.scales;
+  if (!params.scales.empty() && params.scales.size() != model.config.scales.size()) {
+    throw Error("", "--scales",
+                fmt::format("the model was trained on {} scales; got {}",
+                            model.config.scales.size(), params.scales.size()));
+  }
+  if (!options.memory_limit.empty()) {
+    params.memory_limit_bytes = edges::parse_memory_size(options.memory_limit);
+  }
+  params.tile_points = options.tile_points;
+  Distributed& world = Distributed::world();
+  edges::TiledClassifyStats stats;
+  try {
+    stats = edges::classify_las(options.input, options.output, model, params);
+  } catch (const Error& e) {
+    if (world.size() <= 1) throw;
+    // The other ranks wait in a collective call: end them all.
+    std::fprintf(stderr, "glint: error (rank %d of %d): %s\n", world.rank(), world.size(),
+                 e.what());
+    world.abort(1);
+  }
+  if (world.size() > 1) {
+    fmt::print(
+        "rank {}/{}: {} tiles, {} points classified in {:.2f} s (read {:.2f} s, write "
+        "{:.2f} s)\n",
+        world.rank(), world.size(), stats.rank_tiles, stats.rank_points, stats.classify_s,
+        stats.read_s, stats.write_s);
+    if (world.rank() != 0) return;
+  }
+  fmt::print(
+      "{}: {} points -> {} non-edge, {} sharp, {} boundary in {:.2f} s ({:.0f} points/s){} -> "
+      "{}\n",
+      options.input, stats.points, stats.labels[0], stats.labels[1], stats.labels[2], stats.total_s,
+      double(stats.points) / stats.total_s,
+      stats.tiled
+          ? fmt::format("; {} tiles of {:.1f} m, halo up to {:.2f} m, {:.1f} % halo "
+                        "points, {} rank(s)",
+                        stats.tiles, stats.tile_side_m, stats.halo_m_max,
+                        100.0 * double(stats.halo_points) / double(stats.points), world.size())
+          : std::string("; whole cloud in memory"),
+      options.output);
+  if (!options.report.empty()) {
+    io::write_json(options.report,
+                   {{"command", command_line()},
+                    {"input", options.input},
+                    {"output", options.output},
+                    {"model", model_path},
+                    {"scales", options.scales.empty() ? model.config.scales : options.scales},
+                    {"points", stats.points},
+                    {"labels",
+                     {{"non_edge", stats.labels[0]},
+                      {"sharp", stats.labels[1]},
+                      {"boundary", stats.labels[2]}}},
+                    {"ranks", world.size()},
+                    {"tiled", stats.tiled},
+                    {"tiles", stats.tiles},
+                    {"points_per_tile_limit", stats.points_per_tile_limit},
+                    {"tile_side_m", stats.tile_side_m},
+                    {"halo_m_max", stats.halo_m_max},
+                    {"halo_points", stats.halo_points},
+                    {"timings_s",
+                     {{"read", stats.read_s},
+                      {"classify", stats.classify_s},
+                      {"write", stats.write_s},
+                      {"total", stats.total_s}}},
+                    {"points_per_s", double(stats.points) / stats.total_s}});
+  }
+}
+
 void run_classify(const ClassifyOptions& options) {
+  if (is_las(options.input)) return run_classify_las(options);
   if (std::filesystem::path(options.output).extension() != ".ply") {
     throw Error(options.output, "", "the output must be a .ply file");
   }
@@ -101,9 +197,18 @@ void register_edges_classify(CLI::App& edges) {
       "Writes a binary PLY with uchar scalar_label, float scalar_p_sharp, float\n"
       "scalar_p_boundary (CloudCompare shows scalar_* as scalar fields) and red/green/blue\n"
       "(red = sharp, green = boundary) besides the input's own properties.\n"
-      "Example: glint edges classify scan.ply -o scan_edges.ply --png scan_edges.png");
+      "LAS 1.2-1.4 (formats 0-10, uncompressed) is written back as LAS with Extra Bytes\n"
+      "bounded_label, p_sharp, p_boundary; every input field (Classification included) and\n"
+      "VLR is kept. A LAS cloud larger than --memory-limit is classified in tiles with\n"
+      "measured halos (same labels as in one piece); under mpirun (MPI build) the tiles\n"
+      "are shared by the ranks and one output file is written.\n"
+      "Example: glint edges classify scan.ply -o scan_edges.ply --png scan_edges.png\n"
+      "         glint edges classify survey.las -o survey_edges.las --memory-limit 2G\n"
+      "         mpirun -n 4 glint edges classify survey.las -o survey_edges.las");
   command->add_option("input", options->input, "Input point cloud")->required();
-  command->add_option("-o,--output", options->output, "Output PLY")->required()->check(kOutputFile);
+  command->add_option("-o,--output", options->output, "Output PLY (or LAS for LAS input)")
+      ->required()
+      ->check(kOutputFile);
   command->add_option("--model", options->model,
                       "Model JSON (default: the shipped 3-class models/bounded-3c.json; "
                       "models/bounded-2c.json has no boundary class)");
@@ -118,6 +223,12 @@ void register_edges_classify(CLI::App& edges) {
                    "Open3D (gap > 90 degrees among neighbours within 1.5 point spacings)")
       ->check(CLI::IsMember({"bounded", "angle-gap"}))
       ->capture_default_str();
+  command->add_option("--memory-limit", options->memory_limit,
+                      "LAS input: memory to stay within, e.g. 2G (default: 3/4 of the "
+                      "machine's); a larger cloud is classified tile by tile");
+  command->add_option("--tile-points", options->tile_points,
+                      "LAS input: at most this many points per tile, halo included (default: "
+                      "what --memory-limit allows)");
   command->add_option("--png", options->png, "Also draw the labelled cloud to this PNG");
   command->add_option("--report", options->report, "Write a JSON report (counts, timings)")
       ->check(kOutputFile);

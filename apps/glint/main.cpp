@@ -9,6 +9,7 @@
 #include "cli_support.h"
 #include "commands.h"
 #include "core/build_info.h"
+#include "core/distributed.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/parallel.h"
@@ -65,6 +66,7 @@ int main(int argc, char** argv) {
   });
 
   try {
+    glint::refuse_mpi_launch_without_mpi();
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
