@@ -50,7 +50,7 @@ struct LightTransportParams {
 
 class LightTransport {
  public:
-  // `voxel_capacity`: ObservationGrid::voxel_capacity() of the grid it serves. Throws
+  // `voxel_capacity`: ObservationGrid::voxel_pool_size() of the grid it serves. Throws
   // glint::Error for bad parameters.
   LightTransport(const LightTransportParams& params, std::size_t voxel_capacity);
 

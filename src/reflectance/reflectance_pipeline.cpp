@@ -46,7 +46,7 @@ ReflectancePipeline::ReflectancePipeline(const Intrinsics& intrinsics,
       segment_map_(params.segments),
       depth_segmenter_(halved_segmentation_params(params)),
       specular_(network, with_saturation(params.specular, params.exposure)),
-      transport_(params.light_transport, grid_.voxel_capacity()),
+      transport_(params.light_transport, grid_.voxel_pool_size()),
       lights_(std::move(lights)) {
   if (params.albedo_refresh_frames < 1)
     throw Error("reflectance pipeline", "albedo_refresh_frames", "must be >= 1");

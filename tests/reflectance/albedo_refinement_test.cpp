@@ -235,7 +235,7 @@ TEST(AlbedoRefinement, ShadowedLightsAndIndirectLightAreTakenOutOfEquationSeven)
   lights[1].position = {-1.0, 1.5, -0.5};
   lights[1].intensity = {2, 2, 2};
   const Eigen::Vector3f position(0.1f, 0.0f, 0.2f), normal = Eigen::Vector3f::UnitY();
-  const PointLighting lighting{.lit = kAllLights & ~LightMask{1},  // light 1 shadowed
+  const PointLighting lighting{.lit = kAllLights & ~LightMask{2},  // light 1 shadowed
                                .indirect = Eigen::Vector3f(0.4f, 0.3f, 0.2f)};
   const std::vector<render::PointLight> reaching{lights[0]};
   std::vector<Observation> obs;
@@ -250,9 +250,14 @@ TEST(AlbedoRefinement, ShadowedLightsAndIndirectLightAreTakenOutOfEquationSeven)
                                      m.alpha, AlbedoAverage::median, INFINITY, lighting);
   ASSERT_TRUE(refined.has_value());
   EXPECT_TRUE(refined->kd.isApprox(m.kd, 2e-3f)) << refined->kd.transpose();
-  // The paper's model (every light, no indirect light) reads it darker.
-  const auto unshadowed = refine_albedo(obs.data(), int(obs.size()), position, normal, lights,
-                                        m.ks, m.alpha, AlbedoAverage::median);
+  // Leaving the indirect light out reads the albedo too bright; the shadow, too dark.
+  const auto direct_only =
+      refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks, m.alpha,
+                    AlbedoAverage::median, INFINITY, PointLighting{.lit = lighting.lit});
+  EXPECT_GT(direct_only->kd.x(), 1.1f * m.kd.x());
+  const auto unshadowed =
+      refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks, m.alpha,
+                    AlbedoAverage::median, INFINITY, PointLighting{.indirect = lighting.indirect});
   EXPECT_LT(unshadowed->kd.x(), 0.9f * m.kd.x());
 
   // Every light shadowed: the indirect light alone gives the albedo.
