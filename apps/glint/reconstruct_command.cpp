@@ -255,8 +255,7 @@ void run_reconstruct(ReconstructOptions options) {
       pipeline.observations().voxel_count(), timings.median_ms("geometry"),
       timings.median_ms("observations"), timings.median_ms("segmentation"),
       timings.median_ms("shadows"), timings.median_ms("indirect"), timings.median_ms("specular"),
-      timings.median_ms("albedo"), timings.median_ms("total"),
-      options.output);
+      timings.median_ms("albedo"), timings.median_ms("total"), options.output);
   const reflectance::SpecularParams& specular = options.params.specular;
   const MaterialCoverage coverage = material_coverage(pipeline, specular.min_distinct_voxels);
   if (coverage.without_material > 0) {
@@ -482,7 +481,8 @@ void register_reconstruct_command(CLI::App& app) {
   reflectance::LightTransportParams& transport = params.light_transport;
   command
       ->add_option_function<std::string>(
-          "--shadows", [options](const std::string& value) {
+          "--shadows",
+          [options](const std::string& value) {
             options->params.light_transport.shadows = value == "on";
           },
           "Shadows: eq. 7, the hemi-images, the lobe fit and the re-renderings count only the "

@@ -63,13 +63,10 @@ inline float tangent_of(float cosine) { return std::sqrt(1 - cosine * cosine) / 
 // clipped: their albedo would come out too dark, so they are left out unless all of them clipped
 // (their albedo then a lower bound).
 // No allocation.
-std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int count,
-                                           const Eigen::Vector3f& position,
-                                           const Eigen::Vector3f& normal,
-                                           const std::vector<render::PointLight>& lights,
-                                           const Eigen::Vector3f& ks, float alpha,
-                                           AlbedoAverage average = AlbedoAverage::mean,
-                                           float saturated_radiance = INFINITY,
-                                           const PointLighting& lighting = {});
+std::optional<RefinedAlbedo> refine_albedo(
+    const Observation* observations, int count, const Eigen::Vector3f& position,
+    const Eigen::Vector3f& normal, const std::vector<render::PointLight>& lights,
+    const Eigen::Vector3f& ks, float alpha, AlbedoAverage average = AlbedoAverage::mean,
+    float saturated_radiance = INFINITY, const PointLighting& lighting = {});
 
 }  // namespace glint::reflectance

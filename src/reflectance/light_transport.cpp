@@ -51,8 +51,7 @@ bool diffuse_radiance(const ObservationGrid& grid, int u, Eigen::Vector3f& radia
   if (count == 0) return false;
   const Observation* observations = grid.observations(u);
   std::array<std::pair<float, int>, kMaxObservationsPerVoxel> luminance;
-  for (int k = 0; k < count; ++k)
-    luminance[std::size_t(k)] = {observations[k].colour().mean(), k};
+  for (int k = 0; k < count; ++k) luminance[std::size_t(k)] = {observations[k].colour().mean(), k};
   std::nth_element(luminance.begin(), luminance.begin() + count / 2, luminance.begin() + count);
   radiance = observations[luminance[std::size_t(count / 2)].second].colour();
   return true;
@@ -177,9 +176,10 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
       const Eigen::Matrix3f to_world = local_frame(normal).transpose();
       const Eigen::Vector3f origin = grid.position(v) + params_.ray_offset_m * normal;
       const Eigen::Vector3i place = grid.voxel_coordinates(v);
-      const std::uint64_t hash = mix(params_.seed ^ mix(std::uint64_t(std::uint32_t(place.x())) ^
-                                                         std::uint64_t(std::uint32_t(place.y())) << 21 ^
-                                                         std::uint64_t(std::uint32_t(place.z())) << 42));
+      const std::uint64_t hash =
+          mix(params_.seed ^ mix(std::uint64_t(std::uint32_t(place.x())) ^
+                                 std::uint64_t(std::uint32_t(place.y())) << 21 ^
+                                 std::uint64_t(std::uint32_t(place.z())) << 42));
       const float shift_a = float(hash >> 40) * 0x1p-24f;
       const float shift_b = float((hash >> 16) & 0xFFFFFF) * 0x1p-24f;
       const int rays = indirect_rays_[v] < n ? params_.indirect_rays_per_frame : 1;
@@ -193,12 +193,11 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
         const float t_max = std::min(params_.indirect_max_distance_m, box.exit(origin, direction));
         const fusion::MarchEnd hit =
             fusion::first_surface(sampler, volume, origin, direction, 0.0f, t_max);
-        if (hit.back_face) continue;  // unknown radiance: not counted
+        if (hit.back_face) continue;                         // unknown radiance: not counted
         Eigen::Vector3f radiance = Eigen::Vector3f::Zero();  // none beyond the reconstruction
         if (hit.t > 0) {
           const Eigen::Vector3f h = origin + direction * hit.t;
-          if (!on_light(lights, h, margin) &&
-              !hit_radiance(grid, h, direction, blocks, radiance))
+          if (!on_light(lights, h, margin) && !hit_radiance(grid, h, direction, blocks, radiance))
             continue;
         }
         if (indirect_rays_[v] < n) {
@@ -215,7 +214,8 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
 PointLighting PointLightingQuery::operator()(const Eigen::Vector3f& p, const Eigen::Vector3f& n) {
   PointLighting result;
   const LightTransportParams& params = transport_.params();
-  if (params.shadows) result.lit = shadow_mask(sampler_, volume_, lights_, p, n, params.ray_offset_m);
+  if (params.shadows)
+    result.lit = shadow_mask(sampler_, volume_, lights_, p, n, params.ray_offset_m);
   if (params.indirect)
     if (const int v = grid_.find(p, &blocks_); v >= 0)
       result.indirect = transport_.lighting(v).indirect;

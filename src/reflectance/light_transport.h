@@ -39,9 +39,9 @@ struct LightTransportParams {
   // voxel, and a ray starting 1 cm above it no longer meets it (tested on a tilted plane).
   float ray_offset_m = 0.01f;
   int shadow_refresh_frames = 8;
-  int indirect_rays = 64;          // n of the estimate
-  int indirect_rays_per_frame = 2; // while a voxel has fewer than indirect_rays
-  int indirect_refresh_frames = 8; // afterwards one ray every this many frames it is seen
+  int indirect_rays = 64;           // n of the estimate
+  int indirect_rays_per_frame = 2;  // while a voxel has fewer than indirect_rays
+  int indirect_refresh_frames = 8;  // afterwards one ray every this many frames it is seen
   // A voxel with fewer rays than this counts no indirect light yet (its estimate too noisy).
   int indirect_min_rays = 8;
   float indirect_max_distance_m = 10;

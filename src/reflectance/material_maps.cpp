@@ -14,8 +14,7 @@
 namespace glint::reflectance {
 
 WardShading ward_shading(float alpha, const Eigen::Vector3f& p, const Eigen::Vector3f& n,
-                         const Eigen::Vector3f& eye,
-                         const std::vector<render::PointLight>& lights,
+                         const Eigen::Vector3f& eye, const std::vector<render::PointLight>& lights,
                          const PointLighting& lighting) {
   WardShading shading{lighting.indirect, Eigen::Vector3f::Zero()};
   const Eigen::Vector3f wo = (eye - p).normalized();

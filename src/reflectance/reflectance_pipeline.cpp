@@ -93,10 +93,10 @@ void ReflectancePipeline::refine_albedo_of_visible() {
       const int segment = grid_.segment(v);
       const SegmentMaterial* material = specular_.material(segment);
       if (!material) continue;
-      const auto refined = refine_albedo(
-          grid_.observations(v), grid_.observation_count(v), grid_.position(v), grid_.normal(v),
-          lights_, material->ward.ks, material->ward.alpha, params_.albedo_average, clipped,
-          transport_.lighting(v));
+      const auto refined =
+          refine_albedo(grid_.observations(v), grid_.observation_count(v), grid_.position(v),
+                        grid_.normal(v), lights_, material->ward.ks, material->ward.alpha,
+                        params_.albedo_average, clipped, transport_.lighting(v));
       // Each voxel is written by one iteration only: the due list holds it once.
       grid_.has_refined_kd(v) = refined.has_value();
       if (!refined) continue;

@@ -89,8 +89,8 @@ void SpecularEstimator::update(const ObservationGrid& grid, const SegmentMap& se
     std::vector<float> images(std::size_t(count) * image_floats);
     for (int k = 0; k < sampled; ++k) {
       const int v = voxels[k];
-      const Eigen::Vector3f scale = hemi_input_scale(network_.input(), lights, grid.position(v),
-                                                     grid.normal(v), lighting(v));
+      const Eigen::Vector3f scale =
+          hemi_input_scale(network_.input(), lights, grid.position(v), grid.normal(v), lighting(v));
       make_hemi_image(grid.observations(v), grid.observation_count(v), grid.normal(v), hemi_,
                       images.data() + std::size_t(k) * image_floats, scale);
     }

@@ -268,9 +268,9 @@ TEST(AlbedoRefinement, ShadowedLightsAndIndirectLightAreTakenOutOfEquationSeven)
         Eigen::Vector3f(std::cos(0.6f * k), 0.5f, std::sin(0.6f * k)).normalized();
     unlit.emplace_back(m.kd.cwiseProduct(dark.indirect) / float(M_PI), direction, k);
   }
-  const auto from_indirect = refine_albedo(unlit.data(), int(unlit.size()), position, normal,
-                                           lights, m.ks, m.alpha, AlbedoAverage::mean, INFINITY,
-                                           dark);
+  const auto from_indirect =
+      refine_albedo(unlit.data(), int(unlit.size()), position, normal, lights, m.ks, m.alpha,
+                    AlbedoAverage::mean, INFINITY, dark);
   ASSERT_TRUE(from_indirect.has_value());
   EXPECT_TRUE(from_indirect->kd.isApprox(m.kd, 2e-3f)) << from_indirect->kd.transpose();
   EXPECT_FLOAT_EQ(from_indirect->light_cosine(), 1.0f);  // indirect light counts as head-on
