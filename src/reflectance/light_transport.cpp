@@ -95,6 +95,7 @@ LightTransport::LightTransport(const LightTransportParams& params, std::size_t v
   positive(params.indirect_rays, "indirect_rays");
   positive(params.indirect_rays_per_frame, "indirect_rays_per_frame");
   positive(params.indirect_refresh_frames, "indirect_refresh_frames");
+  positive(params.indirect_every_frames, "indirect_every_frames");
   if (params.indirect_rays > 65535)
     throw Error("light transport", "indirect_rays", "must be <= 65535");
   if (params.indirect_min_rays < 0 || params.indirect_min_rays > params.indirect_rays)
@@ -158,11 +159,13 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
   due_.clear();
   for (const VisibleVoxel& seen : grid.visible())
     if (grid.has_surface(seen.voxel) &&
-        (indirect_rays_[seen.voxel] < n ||
-         (seen.voxel + frame) % params_.indirect_refresh_frames == 0))
+        (seen.voxel + frame) % (indirect_rays_[seen.voxel] < n ? params_.indirect_every_frames
+                                                               : params_.indirect_refresh_frames) ==
+            0)
       due_.push_back(seen.voxel);
   const WorldBox box(occupancy, volume);
-  const float margin = 2 * float(volume.params().voxel_size_m);
+  // A hit this close to a light's proxy lies on it, or in an observation voxel it shares.
+  const float margin = 2 * float(grid.params().voxel_size_m);
   // The additive recurrence of the plastic number (Roberts' R2 sequence): low-discrepancy in
   // [0, 1)^2 for any number of points, so a voxel's directions stratify however many it has
   // been given; each voxel's sequence is shifted (Cranley-Patterson) by a hash of its place.
@@ -199,6 +202,8 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
           const Eigen::Vector3f h = origin + direction * hit.t;
           if (!on_light(lights, h, margin) && !hit_radiance(grid, h, direction, blocks, radiance))
             continue;
+          if (!(radiance.maxCoeff() < params_.saturated_radiance))
+            radiance = Eigen::Vector3f::Zero();
         }
         if (indirect_rays_[v] < n) {
           indirect_sum_[v] += radiance;

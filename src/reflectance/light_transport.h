@@ -11,7 +11,7 @@
 //    bounce before it), treating the emitting surfaces as diffuse: a hit voxel emits the colour
 //    of its observation of median luminance, which leaves out its highlights. The Monte Carlo
 //    estimate E = pi / n * sum_k L(w_k) (cosine-weighted directions, pdf cos / pi) accumulates a
-//    few rays per frame the voxel is seen, up to indirect_rays, then follows the changing
+//    few rays every few frames the voxel is seen, up to indirect_rays, then follows the changing
 //    reconstruction as a moving average of that many rays, one ray every
 //    indirect_refresh_frames frames. A ray that leaves the reconstruction counts as dark; one that
 //    hits a surface never observed, or one from behind, is not counted (no radiance is known
@@ -19,6 +19,7 @@
 // Rays start ray_offset_m off the surface point along its normal: the point is the TSDF's zero
 // crossing, which a ray starting on it would find again (self-shadowing acne).
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -38,13 +39,21 @@ struct LightTransportParams {
   // 2 TSDF voxels at the default 5 mm: the fused surface of a flat face scatters by about one
   // voxel, and a ray starting 1 cm above it no longer meets it (tested on a tilted plane).
   float ray_offset_m = 0.01f;
-  int shadow_refresh_frames = 8;
-  int indirect_rays = 64;           // n of the estimate
-  int indirect_rays_per_frame = 2;  // while a voxel has fewer than indirect_rays
-  int indirect_refresh_frames = 8;  // afterwards one ray every this many frames it is seen
+  int shadow_refresh_frames = 16;
+  int indirect_rays = 64;  // n of the estimate
+  // While a voxel has fewer than indirect_rays: this many rays every indirect_every_frames
+  // frames it is seen (staggered over the voxels); the gather was 10x the observation stage's
+  // time with 2 rays every frame (bunnies, 2 cm).
+  int indirect_rays_per_frame = 2;
+  int indirect_every_frames = 4;
+  int indirect_refresh_frames = 16;  // afterwards one ray every this many frames it is seen
   // A voxel with fewer rays than this counts no indirect light yet (its estimate too noisy).
   int indirect_min_rays = 8;
   float indirect_max_distance_m = 10;
+  // A hit voxel whose median observation reaches this radiance in a channel has clipped: a lamp
+  // (its proxy in a synthetic sequence) or its glare, whose light is already direct; it counts
+  // as dark. The pipeline sets it from the exposure.
+  float saturated_radiance = INFINITY;
   std::uint64_t seed = 1;  // the rays' directions (per voxel, from its grid coordinates)
 };
 

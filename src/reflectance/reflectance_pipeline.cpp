@@ -26,6 +26,12 @@ SpecularParams with_saturation(SpecularParams params, float exposure) {
   return params;
 }
 
+// Clipped emitters count as dark in the indirect gather.
+LightTransportParams with_saturation(LightTransportParams params, float exposure) {
+  params.saturated_radiance = saturated_radiance(exposure);
+  return params;
+}
+
 // min_segment_px is given at full resolution; each halving quarters it.
 DepthSegmentationParams halved_segmentation_params(const ReflectanceParams& params) {
   DepthSegmentationParams halved = params.segmentation;
@@ -46,7 +52,7 @@ ReflectancePipeline::ReflectancePipeline(const Intrinsics& intrinsics,
       segment_map_(params.segments),
       depth_segmenter_(halved_segmentation_params(params)),
       specular_(network, with_saturation(params.specular, params.exposure)),
-      transport_(params.light_transport, grid_.voxel_pool_size()),
+      transport_(with_saturation(params.light_transport, params.exposure), grid_.voxel_pool_size()),
       lights_(std::move(lights)) {
   if (params.albedo_refresh_frames < 1)
     throw Error("reflectance pipeline", "albedo_refresh_frames", "must be >= 1");

@@ -209,6 +209,7 @@ TEST(LightTransport, GatheredIndirectIrradianceOfAFloorBesideAWhiteWallMatchesAQ
   const std::vector<render::PointLight> lights{light};
   LightTransportParams params{.shadows = false, .indirect_rays = 4096};
   params.indirect_rays_per_frame = params.indirect_rays;
+  params.indirect_every_frames = 1;
   LightTransport transport(params, scene.grid().voxel_pool_size());
   const fusion::BlockOccupancy occupancy(scene.geometry());
   transport.update_indirect(scene.grid(), scene.geometry(), occupancy, lights, 0);
