@@ -207,7 +207,7 @@ TEST(LightTransport, GatheredIndirectIrradianceOfAFloorBesideAWhiteWallMatchesAQ
   scene.see(render::look_at({0.9, 0.6, 0.0}, {0.3, 0.0, 0.0}), {64, 48, 200.0, 200.0, 31.5, 23.5},
             1);
   const std::vector<render::PointLight> lights{light};
-  LightTransportParams params{.shadows = false, .indirect_rays = 4096};
+  LightTransportParams params{.shadows = false, .indirect = true, .indirect_rays = 4096};
   params.indirect_rays_per_frame = params.indirect_rays;
   params.indirect_every_frames = 1;
   LightTransport transport(params, scene.grid().voxel_pool_size());
