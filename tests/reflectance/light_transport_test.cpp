@@ -128,7 +128,7 @@ TEST(LightTransport, AVoxelBehindAnOccluderGetsNoLightFromThatLight) {
   });
   scene.see(render::look_at({0.8, 0, 0.2}, {0, 0, 1}), kWideCamera, 0);
   const std::vector<render::PointLight> lights{light_at({0, 0, 0.3}), light_at({1.2, 0, 0.3})};
-  LightTransport transport({.indirect = false}, scene.grid().voxel_pool_size());
+  LightTransport transport({.shadows = true}, scene.grid().voxel_pool_size());
   const fusion::BlockOccupancy occupancy(scene.geometry());
   transport.update_shadows(scene.grid(), scene.geometry(), occupancy, lights, 0);
   int shadowed = 0, lit = 0;
