@@ -8,9 +8,10 @@
 # estimates the lights once per scene from its light capture (glint lights), and reconstructs
 # each rendering with glint's own segmentation, ground-truth poses and 2 cm observation voxels,
 # scored every 10th frame against the ground truth:
-#   before  --shadows off --indirect off (the paper's image model),
-#   after   the defaults (shadows and indirect light on),
-# plus, for the timing tables, the "after" settings on each rendering b at 1 cm and 2 cm with
+#   before    the defaults, --shadows off --indirect off (the paper's image model),
+#   after     --shadows on,
+#   indirect  --shadows on --indirect on,
+# plus, for the timing tables, the "indirect" settings on each rendering b at 1 cm and 2 cm with
 # ground-truth segmentation (TIMING_SCENES). Reports: OUT/<scene>-<render>-<variant>.json;
 # summary: OUT/summary.md (scripts/light-transport-summary.py).
 #   scripts/eval-light-transport.sh GLINT DATA [OUT] [SCENES] [FRAMES] [TIMING_SCENES]
@@ -60,14 +61,16 @@ for scene in $SCENES; do
   for r in a b c; do
     render "$scene" "$r" || continue
     reconstruct "$scene" "$r" before --shadows off --indirect off --eval-every 10
-    reconstruct "$scene" "$r" after --eval-every 10
+    reconstruct "$scene" "$r" after --shadows on --eval-every 10
+    reconstruct "$scene" "$r" indirect --shadows on --indirect on --eval-every 10
   done
 done
 for scene in $TIMING_SCENES; do
   lights "$scene"
   render "$scene" b
-  reconstruct "$scene" b timing-2cm --gt-segmentation --eval-every 0
-  reconstruct "$scene" b timing-1cm --gt-segmentation --obs-voxel 0.01 --eval-every 0
+  reconstruct "$scene" b timing-2cm --gt-segmentation --shadows on --indirect on --eval-every 0
+  reconstruct "$scene" b timing-1cm --gt-segmentation --shadows on --indirect on \
+    --obs-voxel 0.01 --eval-every 0
 done
 python3 "$(dirname "$0")/light-transport-summary.py" "$OUT" > "$OUT/summary.md"
 echo "eval-light-transport: reports in $OUT, summary in $OUT/summary.md"
