@@ -13,6 +13,10 @@ packages=(
   libembree-dev libtinyobjloader-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  # The Python module (python/) and its tests; matplotlib for examples/python.
+  python3-dev python3-numpy python3-pybind11 pybind11-dev python3-pytest python3-matplotlib
+  # make package: CPack's .deb finds its shared-library dependencies with dpkg-shlibdeps and file.
+  dpkg-dev file
 )
 if [[ "${1:-}" == "--peers" ]]; then
   packages+=(libopen3d-dev libpcl-dev libcgal-dev)

@@ -40,7 +40,7 @@ struct EvalOptions {
   int trace_every = 0;
   std::string save;
   std::string report;
-  DenoiserOptions denoiser;
+  denoise::DenoiserSettings denoiser;
 };
 
 struct TestImage {
@@ -181,9 +181,9 @@ void run_eval(const EvalOptions& options) {
         point["iteration"] = iteration;
         trace.push_back(std::move(point));
       };
-      const DenoiseRun run = run_denoiser(method, options.denoiser, noisy,
-                                          method_is_guided(method) ? &guidance : nullptr,
-                                          score_estimate, options.trace_every);
+      const denoise::DenoiseRun run = denoise::run_denoiser(
+          method, options.denoiser, noisy, denoise::method_is_guided(method) ? &guidance : nullptr,
+          score_estimate, options.trace_every);
       nlohmann::json values = quality(clean, run.result, mask, clean_mask);
       if (!trace.empty()) values["trace"] = trace;
       values["seconds"] = run.stats.seconds;
@@ -290,7 +290,7 @@ void register_denoise_eval(CLI::App& denoise) {
   command->add_option("--save", options->save, "Folder for clean/noisy/mask/guidance/results");
   command->add_option("--report", options->report, "JSON report (per image and summary)")
       ->check(kOutputFile);
-  options->denoiser.add_options(*command);
+  add_denoiser_options(*command, options->denoiser);
   command->footer(
       "Examples:\n"
       "  glint denoise eval --set kodak --count 8 --report denoise-kodak.json\n"

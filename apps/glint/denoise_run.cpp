@@ -24,25 +24,18 @@ struct RunOptions {
   int snapshot_every = 0;
   int depth = 8;
   std::string report;
-  DenoiserOptions denoiser;
+  denoise::DenoiserSettings denoiser;
 };
 
 void run_denoise(const RunOptions& options) {
   const ImageF noisy = io::read_image(options.input);
   ImageF guidance;
-  if (method_is_guided(options.method)) {
+  if (denoise::method_is_guided(options.method)) {
     if (!options.guidance.empty()) {
       guidance = io::read_image(options.guidance);
-      if (!guidance.same_size(noisy))
-        throw Error(options.guidance, "",
-                    fmt::format("guidance map is {}x{} but the image is {}x{}", guidance.width(),
-                                guidance.height(), noisy.width(), noisy.height()));
-      if (guidance.channels() != 1)
-        throw Error(options.guidance, "", "guidance map must have one channel");
+      denoise::check_guidance(guidance, noisy, options.guidance);
     } else {
-      guidance =
-          denoise::guidance_from_noise(denoise::noise_level(noisy, options.denoiser.noise_params()))
-              .map;
+      guidance = denoise::estimate_guidance(noisy, options.denoiser);
     }
     if (!options.save_guidance.empty())
       io::write_image(options.save_guidance, guidance, io::PngDepth::sixteen);
@@ -59,9 +52,9 @@ void run_denoise(const RunOptions& options) {
                       estimate, depth);
     };
   }
-  const DenoiseRun run =
-      run_denoiser(options.method, options.denoiser, noisy, guidance.empty() ? nullptr : &guidance,
-                   snapshot, options.snapshot_every);
+  const denoise::DenoiseRun run = denoise::run_denoiser(options.method, options.denoiser, noisy,
+                                                        guidance.empty() ? nullptr : &guidance,
+                                                        snapshot, options.snapshot_every);
   io::write_image(options.output, run.result, depth);
   log().info("{}: {} on {}, {} iterations, {:.1f} s -> {}", options.input, options.method,
              run.stats.device, run.stats.iterations, run.stats.seconds, options.output);
@@ -94,7 +87,7 @@ void register_denoise_run(CLI::App& denoise) {
       ->required()
       ->check(kOutputFile);
   command->add_option("--method", options->method, "guided-s2s, s2s, guided-dip, dip or nlm")
-      ->check(CLI::IsMember(denoise_method_names()))
+      ->check(CLI::IsMember(denoise::denoise_method_names()))
       ->capture_default_str();
   command->add_option("--guidance", options->guidance,
                       "Guidance map (one channel, the image's size; from 'noise-map')");
@@ -110,7 +103,7 @@ void register_denoise_run(CLI::App& denoise) {
       ->check(CLI::IsMember({8, 16}))
       ->capture_default_str();
   command->add_option("--report", options->report, "JSON report")->check(kOutputFile);
-  options->denoiser.add_options(*command);
+  add_denoiser_options(*command, options->denoiser);
   command->footer(
       "Examples:\n"
       "  glint denoise run noisy.png -o clean.png                      # guided S2S, fast\n"

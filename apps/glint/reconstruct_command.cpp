@@ -3,7 +3,6 @@
 // with per-vertex albedo and segment, materials.json, lights.json, re-rendered frames and, on
 // synthetic sequences with ground truth, the Table 1 metrics and Figure 4 plots.
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -14,10 +13,9 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/progress.h"
+#include "core/resources.h"
 #include "core/timer.h"
-#include "fusion/depth_maps.h"
 #include "fusion/marching_cubes.h"
-#include "fusion/raycast.h"
 #include "io/image_io.h"
 #include "io/json_report.h"
 #include "io/rgbd_sequence.h"
@@ -27,6 +25,7 @@
 #include "reflectance/light_estimation.h"
 #include "reflectance/material_evaluation.h"
 #include "reflectance/material_maps.h"
+#include "reflectance/reconstruction_outputs.h"
 #include "reflectance/reflectance_pipeline.h"
 #include "render/scene_json.h"
 #include "volume_options.h"
@@ -51,32 +50,6 @@ const char* normals_name(const reflectance::ObservationGridParams& params) {
   return params.normal_from_neighbours ? kPlaneNormals : kGradientNormals;
 }
 
-// The model re-rendered from `pose` into `maps`: ray cast (with gradient normals at silhouettes),
-// its normals smoothed within `normal_radius_m` (0: not), and shaded with the pipeline's materials
-// and lights.
-// `fused_depth`: the depth of the frame just fused from `pose`, if it was, which the ray cast
-// starts from (fusion::raycast's depth hint). The three steps are timed into `timings`.
-void render_model(const reflectance::ReflectancePipeline& pipeline, const Intrinsics& intrinsics,
-                  const Pose& pose, float normal_radius_m, StageTimings& timings,
-                  reflectance::MaterialMaps& maps, const ImageF* fused_depth = nullptr) {
-  Stopwatch watch;
-  fusion::SurfaceView view = fusion::raycast(
-      pipeline.geometry(), intrinsics, pose,
-      {.normals = fusion::RaycastNormals::from_gradient, .depth_hint = fused_depth});
-  timings.add("raycast", watch.elapsed_ms());
-  if (normal_radius_m > 0) {
-    watch.restart();
-    view.normals = fusion::smooth_normals(view.points_m, view.normals, view.depth_m, intrinsics,
-                                          normal_radius_m);
-    timings.add("smooth_normals", watch.elapsed_ms());
-  }
-  watch.restart();
-  reflectance::render_material_maps(view, pose, pipeline.observations(), pipeline.materials(),
-                                    pipeline.lights(), pipeline.exposure(), pipeline.albedo_blend(),
-                                    maps, &pipeline.light_transport(), &pipeline.geometry());
-  timings.add("shade", watch.elapsed_ms());
-}
-
 struct ReconstructOptions {
   std::string sequence;
   std::string output;
@@ -90,30 +63,8 @@ struct ReconstructOptions {
   int evaluate_every = 5;
   int render_every = 0;  // 0: only the last frame
   std::string views;     // TUM trajectory of extra poses to re-render at the end
-  // The ray-cast normals of renderings are smoothed within this radius: the TSDF's surface
-  // carries millimetre bumps from the depth quantisation that its per-pixel normals turn into
-  // speckled shading (4 voxels at 5 mm; chosen on cubes, see docs/reflectance/history.md).
-  float render_normal_radius_m = 0.02f;
+  float render_normal_radius_m = reflectance::kRenderNormalRadiusM;
   reflectance::ReflectanceParams params;
-};
-
-// OUT is replaced at the end of a run: only when it is empty or a previous reconstruction (it has
-// materials.json), never a folder or file of the user's that -o happened to name.
-void require_replaceable(const std::string& output) {
-  if (!fs::exists(output)) return;
-  if (fs::is_directory(output) &&
-      (fs::is_empty(output) || fs::exists(fs::path(output) / "materials.json")))
-    return;
-  throw Error(output, "", "exists and is not a glint reconstruction; not replacing it");
-}
-
-// Removes the temporary output folder unless it was renamed into place.
-struct PartialFolder {
-  std::string path;
-  ~PartialFolder() {
-    std::error_code ignored;
-    if (!path.empty()) fs::remove_all(path, ignored);
-  }
 };
 
 reflectance::LightEstimate load_lights(const ReconstructOptions& options) {
@@ -130,17 +81,7 @@ reflectance::LightEstimate load_lights(const ReconstructOptions& options) {
     throw Error(options.sequence, "--lights",
                 "the pipeline needs the scene's lights: give the light-capture sequence or a "
                 "lights.json (--lights), or --gt-lights for a synthetic sequence");
-  if (fs::is_directory(options.lights)) {
-    const io::RgbdSequence capture = io::open_rgbd_sequence(options.lights);
-    ProgressBar progress("lights", capture.frames.size());
-    reflectance::LightEstimate estimate =
-        reflectance::estimate_lights(capture, {}, [&] { progress.advance(); });
-    progress.finish();
-    if (estimate.lights.empty())
-      throw Error(options.lights, "", "no light found in the capture sequence");
-    return estimate;
-  }
-  return reflectance::read_lights_json(options.lights);
+  return reflectance::load_lights(options.lights);
 }
 
 void run_reconstruct(ReconstructOptions options) {
@@ -159,19 +100,15 @@ void run_reconstruct(ReconstructOptions options) {
   const std::vector<io::StampedPose> views = options.views.empty()
                                                  ? std::vector<io::StampedPose>{}
                                                  : io::read_tum_trajectory(options.views);
-  const std::string model_path = options.model.empty()
-                                     ? (fs::path(models_directory()) / "hemicnn.json").string()
-                                     : options.model;
+  const std::string model_path =
+      options.model.empty() ? glint::model_path("hemicnn.json").string() : options.model;
   const reflectance::HemiCnn network = reflectance::HemiCnn::load(model_path);
 
   // Everything goes to a temporary folder renamed onto OUT at the end: a failure leaves no
   // half-written result.
-  const std::string output = options.output;
-  require_replaceable(output);
-  options.output = output + ".partial-" + std::to_string(::getpid());
-  fs::remove_all(options.output);
-  fs::create_directories(fs::path(options.output) / "frames");
-  PartialFolder partial{options.output};
+  reflectance::ReconstructionFolder folder(options.output);
+  const std::string& staging = folder.path();
+  fs::create_directories(fs::path(staging) / "frames");
   reflectance::ReflectancePipeline pipeline(sequence.intrinsics, options.params, network,
                                             lights.lights);
   reflectance::MaterialEvaluation evaluation;
@@ -203,12 +140,13 @@ void run_reconstruct(ReconstructOptions options) {
       if (!result.geometry.integrated) ++lost;
       if (result.geometry.integrated && (evaluate || render)) {
         watch.restart();
-        render_model(pipeline, sequence.intrinsics, result.geometry.camera_to_world,
-                     options.render_normal_radius_m, render_timings, maps, &frame.depth_m);
+        reflectance::render_model(pipeline, sequence.intrinsics, result.geometry.camera_to_world,
+                                  options.render_normal_radius_m, render_timings, maps,
+                                  &frame.depth_m);
         command_timings.add("render", watch.elapsed_ms());
         watch.restart();
         if (evaluate) evaluation.add_frame(int(i), maps, *truth, frame.colour);
-        if (render) write_frame_pictures(options.output, int(i), frame.colour, maps);
+        if (render) write_frame_pictures(staging, int(i), frame.colour, maps);
         command_timings.add("evaluate", watch.elapsed_ms());
       }
       progress.advance();
@@ -218,34 +156,29 @@ void run_reconstruct(ReconstructOptions options) {
 
   if (!options.views.empty()) {
     // Re-renderings of the final model from any poses (e.g. views the camera never took).
-    fs::create_directories(fs::path(options.output) / "views");
+    fs::create_directories(fs::path(staging) / "views");
     ProgressBar progress("views", views.size());
     for (std::size_t k = 0; k < views.size(); ++k) {
       Stopwatch watch;
-      render_model(pipeline, sequence.intrinsics, views[k].pose, options.render_normal_radius_m,
-                   render_timings, maps);
+      reflectance::render_model(pipeline, sequence.intrinsics, views[k].pose,
+                                options.render_normal_radius_m, render_timings, maps);
       command_timings.add("render", watch.elapsed_ms());
-      write_view_pictures((fs::path(options.output) / "views").string(), int(k), maps);
+      write_view_pictures((fs::path(staging) / "views").string(), int(k), maps);
       progress.advance();
     }
     progress.finish();
   }
 
   Stopwatch watch;
-  write_material_mesh((fs::path(options.output) / "mesh.ply").string(), pipeline);
+  reflectance::write_reconstruction(staging, pipeline, lights);
   command_timings.add("mesh", watch.elapsed_ms());
-  write_materials_json((fs::path(options.output) / "materials.json").string(), pipeline);
-  reflectance::write_lights_json((fs::path(options.output) / "lights.json").string(), lights);
   if (has_truth && !evaluation.series().empty()) {
-    write_material_plots((fs::path(options.output) / "materials-over-time.png").string(),
-                         evaluation, options.evaluate_every);
+    write_material_plots((fs::path(staging) / "materials-over-time.png").string(), evaluation,
+                         options.evaluate_every);
     print_evaluation_table(evaluation);
   }
 
-  fs::remove_all(output);
-  fs::rename(options.output, output);
-  partial.path.clear();
-  options.output = output;
+  folder.commit();
   const StageTimings& timings = pipeline.timings();
   log().info(
       "{} frames of {} ({}): {} segments, {} observation voxels; per frame: geometry "
@@ -257,7 +190,8 @@ void run_reconstruct(ReconstructOptions options) {
       timings.median_ms("shadows"), timings.median_ms("indirect"), timings.median_ms("specular"),
       timings.median_ms("albedo"), timings.median_ms("total"), options.output);
   const reflectance::SpecularParams& specular = options.params.specular;
-  const MaterialCoverage coverage = material_coverage(pipeline, specular.min_distinct_voxels);
+  const reflectance::MaterialCoverage coverage =
+      reflectance::material_coverage(pipeline, specular.min_distinct_voxels);
   if (coverage.without_material > 0) {
     const reflectance::ObservationGridParams& grid = options.params.observations;
     log().warn(
@@ -315,7 +249,7 @@ void run_reconstruct(ReconstructOptions options) {
        {"geometry_timings_ms", pipeline.geometry_timings().to_json()},
        {"command_timings_ms", command},
        {"render_timings_ms", render_timings.to_json()},
-       {"materials", materials_json(pipeline)},
+       {"materials", reflectance::materials_json(pipeline)},
        {"material_coverage",
         {{"segments", coverage.segments}, {"without_material", coverage.without_material}}},
        {"evaluation", has_truth ? evaluation.to_json() : nlohmann::json(nullptr)},

@@ -6,12 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <map>
 
-#include "core/parallel.h"
-#include "fusion/marching_cubes.h"
 #include "io/image_io.h"
-#include "io/json_report.h"
 #include "io/plot.h"
 #include "render/sensor.h"
 
@@ -19,10 +15,6 @@ namespace glint::app {
 namespace {
 
 namespace fs = std::filesystem;
-
-nlohmann::json ward_json(const render::WardMaterial& m) {
-  return {{"kd", io::vector_json(m.kd)}, {"ks", io::vector_json(m.ks)}, {"alpha", m.alpha}};
-}
 
 ImageF srgb_picture(const ImageF& linear) {
   ImageF picture = linear;
@@ -42,104 +34,6 @@ Eigen::Vector3f segment_colour(int id) {
 }
 
 }  // namespace
-
-void write_material_mesh(const std::string& path,
-                         const reflectance::ReflectancePipeline& pipeline) {
-  fusion::TriangleMesh mesh = fusion::extract_mesh(pipeline.geometry());
-  const std::size_t n = mesh.vertices.size();
-  std::array<std::vector<float>, 8> values;  // kd rgb, ks rgb, alpha, segment
-  for (auto& v : values) v.assign(n, 0.0f);
-  mesh.colours.assign(n, Eigen::Vector3f::Zero());
-  // Chunks of consecutive vertices (marching cubes emits them block by block), so that each
-  // lookup mostly finds its neighbourhood kept from the vertex before.
-  parallel_for_chunks(n, 1024, [&](std::size_t begin, std::size_t end) {
-    reflectance::MaterialLookup lookup(pipeline.observations(), pipeline.materials(),
-                                       pipeline.albedo_blend());
-    for (std::size_t i = begin; i < end; ++i) {
-      reflectance::PointMaterial material;
-      const bool with_material = lookup(mesh.vertices[i], material);
-      values[7][i] = float(material.segment);
-      if (!with_material) continue;
-      mesh.colours[i] = material.refined.kd;
-      for (int c = 0; c < 3; ++c) {
-        values[c][i] = material.refined.kd[c];
-        values[3 + c][i] = material.fused.ks[c];
-      }
-      values[6][i] = material.fused.alpha;
-    }
-  });
-  const std::array<const char*, 8> names{"kd_r", "kd_g", "kd_b",  "ks_r",
-                                         "ks_g", "ks_b", "alpha", "scalar_segment"};
-  for (int k = 0; k < 8; ++k) mesh.vertex_properties.emplace_back(names[k], std::move(values[k]));
-  mesh.comments = {
-      "glint reconstruct; red green blue: refined diffuse albedo kd, 8-bit sRGB",
-      "kd_*: refined diffuse albedo, ks_*: specular albedo, alpha: Ward roughness (linear)",
-      "scalar_segment: segment id (0 = none); vertices without a material have zeros"};
-  fusion::write_mesh_ply(path, mesh);
-}
-
-MaterialCoverage material_coverage(const reflectance::ReflectancePipeline& pipeline,
-                                   int min_voxels) {
-  const reflectance::SegmentMap& segments = pipeline.segments();
-  MaterialCoverage coverage;
-  for (int id = 1; id <= segments.max_segment_id(); ++id) {
-    if (segments.resolve(id) != id || segments.reservoir_size(id) < min_voxels) continue;
-    ++coverage.segments;
-    if (!pipeline.materials().material(id)) ++coverage.without_material;
-  }
-  return coverage;
-}
-
-nlohmann::json materials_json(const reflectance::ReflectancePipeline& pipeline) {
-  const reflectance::ObservationGrid& grid = pipeline.observations();
-  // Per segment, the sum of the refined kd over all its voxels with one and over the reliable
-  // ones; the mean is over the reliable ones where the segment has any.
-  struct Sum {
-    Eigen::Vector3d kd = Eigen::Vector3d::Zero();
-    int voxels = 0;
-    void add(const Eigen::Vector3f& value) {
-      kd += value.cast<double>();
-      ++voxels;
-    }
-  };
-  struct RefinedSums {
-    Sum all, reliable;
-  };
-  std::map<int, RefinedSums> refined;
-  std::map<int, int> voxels;
-  for (int v = 0; v < int(grid.voxel_count()); ++v) {
-    const int segment = grid.segment(v);
-    if (segment <= 0) continue;
-    ++voxels[segment];
-    if (!grid.has_refined_kd(v)) continue;
-    RefinedSums& sums = refined[segment];
-    sums.all.add(grid.refined_kd(v));
-    if (grid.refined_kd_reliable(v)) sums.reliable.add(grid.refined_kd(v));
-  }
-  nlohmann::json segments = nlohmann::json::array();
-  for (const auto& [id, material] : pipeline.materials().materials()) {
-    if (voxels[id] == 0) continue;  // merged into another segment
-    nlohmann::json entry = ward_json(material.ward);
-    entry["id"] = id;
-    entry["latest"] = ward_json(material.latest);
-    entry["estimates"] = material.estimates;
-    entry["lobe_fitted"] = material.fitted;
-    entry["last_frame"] = material.last_frame;
-    entry["voxels"] = voxels[id];
-    if (const auto found = refined.find(id); found != refined.end()) {
-      const RefinedSums& sums = found->second;
-      const Sum& sum = sums.reliable.voxels > 0 ? sums.reliable : sums.all;
-      entry["kd_refined_mean"] = io::vector_json((sum.kd / sum.voxels).cast<float>());
-    }
-    segments.push_back(entry);
-  }
-  return {{"segments", segments}, {"exposure", pipeline.exposure()}};
-}
-
-void write_materials_json(const std::string& path,
-                          const reflectance::ReflectancePipeline& pipeline) {
-  io::write_json(path, materials_json(pipeline));
-}
 
 void write_view_pictures(const std::string& folder, int index,
                          const reflectance::MaterialMaps& maps) {

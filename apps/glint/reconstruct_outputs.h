@@ -1,34 +1,13 @@
 #pragma once
-// What `glint reconstruct` writes besides its report: the material mesh, materials.json,
-// per-frame pictures, the Figure-4-style plots and the Table-1-style summary on stdout.
-#include <nlohmann/json.hpp>
+// What `glint reconstruct` writes besides its report and reflectance/reconstruction_outputs.h's
+// files: per-frame pictures, the Figure-4-style plots and the Table-1-style summary on stdout.
 #include <string>
 
 #include "core/image.h"
 #include "reflectance/material_evaluation.h"
 #include "reflectance/material_maps.h"
-#include "reflectance/reflectance_pipeline.h"
 
 namespace glint::app {
-
-// Marching-cubes mesh of the geometry; per vertex: the refined kd as colour (8-bit sRGB) and
-// float properties kd_r/g/b (refined), ks_r/g/b, alpha and scalar_segment (0 = none).
-void write_material_mesh(const std::string& path, const reflectance::ReflectancePipeline& pipeline);
-
-// Per segment: fused kd, ks, alpha, the latest estimate, estimate count, voxel count and the
-// mean refined kd of its voxels.
-nlohmann::json materials_json(const reflectance::ReflectancePipeline& pipeline);
-void write_materials_json(const std::string& path,
-                          const reflectance::ReflectancePipeline& pipeline);
-
-// Segments that could carry a material (not merged away, with at least `min_voxels` voxel
-// references: SpecularParams::min_distinct_voxels) and how many of them have none, because no
-// frame found that many of their voxels with SpecularParams::min_observations observations.
-struct MaterialCoverage {
-  int segments = 0, without_material = 0;
-};
-MaterialCoverage material_coverage(const reflectance::ReflectancePipeline& pipeline,
-                                   int min_voxels);
 
 // OUT/frames/NNNNNN-{input,render,render-hemicnn,albedo,segments}.png (8-bit sRGB) and
 // NNNNNN-overview.png (input, re-rendering, refined albedo and segments side by side).

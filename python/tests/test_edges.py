@@ -1,0 +1,83 @@
+"""glint.edges against `glint edges classify|features` on the same cloud."""
+
+import numpy as np
+import pytest
+
+import glint
+
+
+def test_classify_equals_cli(cloud_file, cli, tmp_path):
+    out = tmp_path / "cli.ply"
+    cli("edges", "classify", cloud_file, "-o", out)
+    _, cli_fields = glint.io.read_point_cloud(out)
+
+    xyz, _ = glint.io.read_point_cloud(cloud_file)
+    labels, probs = glint.edges.classify(xyz)
+    assert labels.dtype == np.uint8 and labels.shape == (len(xyz),)
+    assert probs.dtype == np.float32 and probs.shape == (len(xyz), 2)
+    np.testing.assert_array_equal(labels, cli_fields["scalar_label"])
+    np.testing.assert_array_equal(probs[:, 0], cli_fields["scalar_p_sharp"])
+    np.testing.assert_array_equal(probs[:, 1], cli_fields["scalar_p_boundary"])
+
+
+def test_classify_takes_float64_and_any_strides(cloud_file):
+    xyz, _ = glint.io.read_point_cloud(cloud_file)
+    labels, probs = glint.edges.classify(xyz)
+    # float64 holding the same float32 values, and a Fortran-ordered copy: the same result.
+    labels64, probs64 = glint.edges.classify(xyz.astype(np.float64))
+    labels_f, _ = glint.edges.classify(np.asfortranarray(xyz))
+    np.testing.assert_array_equal(labels, labels64)
+    np.testing.assert_array_equal(probs, probs64)
+    np.testing.assert_array_equal(labels, labels_f)
+
+
+def test_classify_scales_and_model_options(cloud_file, cli, tmp_path):
+    from conftest import REPO
+    model = REPO / "models/bounded-2c.json"
+    out = tmp_path / "cli.ply"
+    cli("edges", "classify", cloud_file, "-o", out, "--scales", "64,32,16,8", "--model", model)
+    _, cli_fields = glint.io.read_point_cloud(out)
+    xyz, _ = glint.io.read_point_cloud(cloud_file)
+    labels, probs = glint.edges.classify(xyz, model=model, scales=[64, 32, 16, 8])
+    np.testing.assert_array_equal(labels, cli_fields["scalar_label"])
+    np.testing.assert_array_equal(probs[:, 0], cli_fields["scalar_p_sharp"])
+    assert not probs[:, 1].any()  # a 2-class model has no boundary class
+
+
+def test_features_equal_cli(cloud_file, cli, tmp_path):
+    out = tmp_path / "features.npy"
+    cli("edges", "features", cloud_file, "-o", out, "--scales", "32,16")
+    xyz, _ = glint.io.read_point_cloud(cloud_file)
+    features = glint.edges.features(xyz, scales=[32, 16])
+    assert features.shape == (len(xyz), 24) and features.dtype == np.float32
+    np.testing.assert_array_equal(features, np.load(out))
+
+
+def test_bad_inputs_raise_glint_error():
+    with pytest.raises(glint.Error, match=r"xyz: must be an \(N, 3\) array of positions, got "
+                                          r"shape \(5, 2\)"):
+        glint.edges.classify(np.zeros((5, 2), np.float32))
+    with pytest.raises(glint.Error, match="xyz: must be float32 or float64, got int64"):
+        glint.edges.classify(np.zeros((5, 3), np.int64))
+    with pytest.raises(glint.Error, match="expected a NumPy array, got list"):
+        glint.edges.classify([[0, 0, 0]])
+    bad = np.zeros((200, 3), np.float32)
+    bad[17, 1] = np.nan
+    with pytest.raises(glint.Error, match="xyz: row 17: non-finite coordinate") as caught:
+        glint.edges.classify(bad)
+    assert caught.value.file == "xyz" and caught.value.element == "row 17"
+    assert caught.value.reason == "non-finite coordinate"
+    assert isinstance(caught.value, RuntimeError)
+
+
+def test_errors_carry_the_cli_message(cli, tmp_path):
+    missing = tmp_path / "missing.json"
+    xyz = np.random.default_rng(1).random((300, 3), np.float32)
+    with pytest.raises(glint.Error) as caught:
+        glint.edges.classify(xyz, model=missing)
+    cloud = tmp_path / "c.xyz"
+    glint.io.write_point_cloud(cloud, xyz)
+    result = cli("edges", "classify", cloud, "-o", tmp_path / "o.ply", "--model", missing,
+                 check=False)
+    assert result.returncode == 1
+    assert result.stderr.strip() == f"glint: error: {caught.value}"
