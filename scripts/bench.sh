@@ -7,7 +7,12 @@ DATA=${2:?usage: bench.sh BUILD DATA}
 OUT=build/bench
 mkdir -p "$OUT"
 "$BUILD/bench/edges/edges_throughput" --points 1000000 --model models/bounded-3c.json \
-  --data "$DATA/pointclouds/default-eval" --json "$OUT/edges_throughput.json"
+  --data "$DATA" --json "$OUT/edges_throughput.json"
+# The PCL / Open3D boundary peers, where they were built (scripts/install-deps.sh --peers).
+if [[ -x "$BUILD/bench/edges/boundary_peers" ]]; then
+  "$BUILD/bench/edges/boundary_peers" "$DATA/pointclouds/default-eval" "$DATA/pointclouds/shrec19" \
+    --json "$OUT/boundary_peers.json" >/dev/null
+fi
 "$BUILD/bench/denoise/denoise_speed" --json "$OUT/denoise_speed.json"
 "$BUILD/bench/render/render_speed" --data "$DATA" --threads 2 --json "$OUT/render_speed.json"
 "$BUILD/bench/reflectance/reflectance_kernels" --benchmark_out="$OUT/reflectance_kernels.json" \

@@ -19,7 +19,8 @@ packages=(
   dpkg-dev file
 )
 if [[ "${1:-}" == "--peers" ]]; then
-  packages+=(libopen3d-dev libpcl-dev libcgal-dev)
+  # libopenmpi-dev: Debian's PCL loads VTK, whose CMake package needs MPI's C target.
+  packages+=(libopen3d-dev libpcl-dev libcgal-dev libopenmpi-dev)
 fi
 
 missing=()

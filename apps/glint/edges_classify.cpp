@@ -7,6 +7,8 @@
 #include "commands.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/timer.h"
+#include "edges/angle_gap_baseline.h"
 #include "edges/classifier.h"
 #include "io/json_report.h"
 #include "io/ply.h"
@@ -23,7 +25,20 @@ struct ClassifyOptions {
   std::string png;
   std::string report;
   std::vector<int> scales;
+  std::string method = "bounded";
 };
+
+// The angle-gap baseline as a Classification: labels 0 / 2, p_boundary 0 / 1, no sharp class.
+edges::Classification classify_angle_gap(const PointCloud& cloud) {
+  const Stopwatch watch;
+  edges::Classification result;
+  result.labels = edges::classify_angle_gap(cloud);
+  result.p_sharp.assign(cloud.size(), 0.f);
+  result.p_boundary.resize(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) result.p_boundary[i] = result.labels[i] == 2;
+  result.features_s = watch.elapsed_s();
+  return result;
+}
 
 void run_classify(const ClassifyOptions& options) {
   if (std::filesystem::path(options.output).extension() != ".ply") {
@@ -37,7 +52,8 @@ void run_classify(const ClassifyOptions& options) {
 
   edges::Classification result;
   try {
-    result = edges::classify(cloud, model, options.scales);
+    result = options.method == "angle-gap" ? classify_angle_gap(cloud)
+                                           : edges::classify(cloud, model, options.scales);
   } catch (const Error& e) {
     throw Error(options.input, e.element(), e.reason());
   }
@@ -63,6 +79,7 @@ void run_classify(const ClassifyOptions& options) {
         {{"command", command_line()},
          {"input", options.input},
          {"output", options.output},
+         {"method", options.method},
          {"model", model_path},
          {"scales", options.scales.empty() ? model.config.scales : options.scales},
          {"points", cloud.size()},
@@ -95,6 +112,12 @@ void register_edges_classify(CLI::App& edges) {
                    "Override the model's neighbourhood sizes, largest first, e.g. 256,128,64,32 "
                    "for a cloud much denser than the training data")
       ->delimiter(',');
+  command
+      ->add_option("--method", options->method,
+                   "bounded: the network; angle-gap: the boundary-only baseline of PCL and "
+                   "Open3D (gap > 90 degrees among neighbours within 1.5 point spacings)")
+      ->check(CLI::IsMember({"bounded", "angle-gap"}))
+      ->capture_default_str();
   command->add_option("--png", options->png, "Also draw the labelled cloud to this PNG");
   command->add_option("--report", options->report, "Write a JSON report (counts, timings)")
       ->check(kOutputFile);

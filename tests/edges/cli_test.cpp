@@ -2,6 +2,7 @@
 // (one line naming the file, exit code 1, no output left behind).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -60,6 +61,39 @@ TEST_F(CliTest, SynthTrainClassifyEval) {
   EXPECT_NE(eval.output.find("median"), std::string::npos) << eval.output;
   const auto report = nlohmann::json::parse(std::ifstream(path("eval.json")));
   EXPECT_EQ(report["files"].size(), 4u);
+}
+
+TEST_F(CliTest, AngleGapBaselineInEvalAndClassify) {
+  const CommandResult synth = glint("edges synth -o " + path("sheets") +
+                                    " --count 1 --seed 9 --min-points 2000 --max-points 2000 "
+                                    "--shapes sheet");
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  std::string sheet;
+  for (const auto& entry : fs::directory_iterator(path("sheets")))
+    if (entry.path().extension() == ".ply") sheet = entry.path().string();
+
+  // The boundary task scores the angle-gap column beside CA; the sharp task has none.
+  const CommandResult boundary = glint("edges eval " + sheet + " --pred " + sheet +
+                                       " --task boundary --report " + path("boundary.json"));
+  ASSERT_EQ(boundary.exit_code, 0) << boundary.output;
+  const auto report = nlohmann::json::parse(std::ifstream(path("boundary.json")));
+  EXPECT_TRUE(report["summary"].contains("angle-gap"));
+  EXPECT_GT(report["summary"]["angle-gap"]["median"]["recall"].get<double>(), 0.0);
+  EXPECT_EQ(report["angle_gap_baseline"]["radius_spacings"], 1.5);
+  const CommandResult sharp =
+      glint("edges eval " + sheet + " --pred " + sheet + " --report " + path("sharp.json"));
+  ASSERT_EQ(sharp.exit_code, 0) << sharp.output;
+  EXPECT_FALSE(
+      nlohmann::json::parse(std::ifstream(path("sharp.json")))["summary"].contains("angle-gap"));
+
+  const CommandResult classify =
+      glint("edges classify " + sheet + " -o " + path("gap.ply") + " --method angle-gap");
+  ASSERT_EQ(classify.exit_code, 0) << classify.output;
+  const PointCloud gap = io::read_point_cloud(path("gap.ply"));
+  const auto* labels = gap.get<std::uint8_t>("scalar_label");
+  ASSERT_TRUE(labels);
+  EXPECT_GT(std::count(labels->begin(), labels->end(), 2), 0);
+  EXPECT_EQ(std::count(labels->begin(), labels->end(), 1), 0);
 }
 
 TEST_F(CliTest, BadInputsGiveOneLineAndNoOutput) {
