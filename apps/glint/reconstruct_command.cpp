@@ -182,13 +182,13 @@ void run_reconstruct(ReconstructOptions options) {
   const StageTimings& timings = pipeline.timings();
   log().info(
       "{} frames of {} ({}): {} segments, {} observation voxels; per frame: geometry "
-      "{:.1f}, observations {:.1f}, segmentation {:.1f}, specular {:.1f}, albedo {:.1f}, "
-      "total {:.1f} ms (median) -> {}",
+      "{:.1f}, observations {:.1f}, segmentation {:.1f}, shadows {:.1f}, indirect {:.1f}, "
+      "specular {:.1f}, albedo {:.1f}, total {:.1f} ms (median) -> {}",
       frames, options.sequence, sequence.format, pipeline.segments().max_segment_id(),
       pipeline.observations().voxel_count(), timings.median_ms("geometry"),
       timings.median_ms("observations"), timings.median_ms("segmentation"),
-      timings.median_ms("specular"), timings.median_ms("albedo"), timings.median_ms("total"),
-      options.output);
+      timings.median_ms("shadows"), timings.median_ms("indirect"), timings.median_ms("specular"),
+      timings.median_ms("albedo"), timings.median_ms("total"), options.output);
   const reflectance::SpecularParams& specular = options.params.specular;
   const reflectance::MaterialCoverage coverage =
       reflectance::material_coverage(pipeline, specular.min_distinct_voxels);
@@ -237,6 +237,11 @@ void run_reconstruct(ReconstructOptions options) {
          {"ground_truth_segmentation", options.ground_truth_segmentation},
          {"segment_noise", options.params.segmentation.convexity_noise_k},
          {"exposure", options.params.exposure},
+         {"shadows", options.params.light_transport.shadows},
+         {"indirect", options.params.light_transport.indirect},
+         {"indirect_rays", options.params.light_transport.indirect_rays},
+         {"indirect_rays_per_frame", options.params.light_transport.indirect_rays_per_frame},
+         {"ray_offset_m", options.params.light_transport.ray_offset_m},
          {"model", model_path},
          {"model_input", reflectance::hemi_input_name(network.input())},
          {"lights", lights.capture}}},
@@ -402,10 +407,51 @@ void register_reconstruct_command(CLI::App& app) {
           [options](std::uint64_t seed) {
             options->params.specular.seed = seed;
             options->params.segments.seed = seed;
+            options->params.light_transport.seed = seed;
           },
           "Seed of the voxel sampling (each segment's voxel reservoir and each frame's draw "
-          "from it)")
+          "from it) and of the gather rays' directions")
       ->default_str(std::to_string(params.specular.seed));
+  reflectance::LightTransportParams& transport = params.light_transport;
+  command
+      ->add_option_function<std::string>(
+          "--shadows",
+          [options](const std::string& value) {
+            options->params.light_transport.shadows = value == "on";
+          },
+          "Shadows: eq. 7, the hemi-images, the lobe fit and the re-renderings count only the "
+          "lights a voxel's shadow ray through the fused geometry reaches (off = every light "
+          "reaches every point, as the paper)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->default_str(transport.shadows ? "on" : "off");
+  command
+      ->add_option_function<std::string>(
+          "--indirect",
+          [options](const std::string& value) {
+            options->params.light_transport.indirect = value == "on";
+          },
+          "Interreflections: each voxel's indirect irradiance, gathered over its hemisphere from "
+          "the radiance observed on the surfaces around it, adds to the irradiance eq. 7 and the "
+          "reflectance hemi-images divide by (off = direct light only, as the paper)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->default_str(transport.indirect ? "on" : "off");
+  command
+      ->add_option("--indirect-rays", transport.indirect_rays,
+                   "Cosine-weighted gather rays per voxel in its indirect estimate (afterwards a "
+                   "moving average over this many)")
+      ->check(CLI::Range(1, 65535))
+      ->capture_default_str();
+  command
+      ->add_option("--indirect-rays-per-frame", transport.indirect_rays_per_frame,
+                   "Gather rays cast per seen voxel and frame until it has --indirect-rays")
+      ->check(kPositive)
+      ->capture_default_str();
+  command
+      ->add_option("--ray-offset", transport.ray_offset_m,
+                   "Shadow and gather rays start this far (metres) off the surface along its "
+                   "normal, so they do not find the surface they start on")
+      ->check(kNonNegative)
+      ->capture_default_str();
   command
       ->add_option("--report", options->report,
                    "JSON report: parameters, per-stage timings, materials, evaluation")

@@ -33,6 +33,15 @@ class BlockOccupancy {
     return words_[bit >> 6] >> (bit & 63) & 1;
   }
 
+  // The blocks [low, high] (block coordinates, inclusive) that hold every allocated one; false
+  // where there is none or the bit array was not built (no box is known).
+  bool bounds(Eigen::Vector3i& low, Eigen::Vector3i& high) const {
+    if (words_.empty()) return false;
+    low = low_;
+    high = low_ + size_ - Eigen::Vector3i::Ones();
+    return true;
+  }
+
  private:
   Eigen::Vector3i low_ = Eigen::Vector3i::Zero(), size_ = Eigen::Vector3i::Zero();
   std::vector<std::uint64_t> words_;

@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "fusion/depth_maps.h"
+#include "fusion/ray_march.h"
 #include "fusion/tsdf_sampler.h"
 
 namespace glint::fusion {
@@ -99,108 +100,10 @@ class TileDepthRanges {
   std::vector<std::atomic<std::uint32_t>> near_, far_;
 };
 
-// Voxels a ray skips per step through unobserved voxels of allocated blocks (space behind
-// surfaces, or beside them, that no frame saw). Landing on observed space after such a stride,
-// it steps back and crosses the stride again voxel by voxel, so only an observed stretch
-// shorter than the stride can be missed; with the default band (at least 2 cm) and 5 mm voxels,
-// the observed band in front of any surface is at least 4 voxels deep.
-constexpr int kUnobservedStride = 3;
-
 // How far in front of a hinted depth (voxels) a ray starts first: the model's surface lies
 // within depth noise of the depth just fused, and from there two trilinear samples usually
 // bracket it, where the band's front edge took one or two nearest-voxel steps more.
 constexpr float kHintLead = 2;
-
-// Where a march ended: the depth t (metres along the optical axis) of the first + to - crossing,
-// or 0 when there is none; back_face when it entered a surface from behind (a negative observed
-// sample with no positive one just before it).
-struct MarchEnd {
-  float t = 0;
-  bool back_face = false;
-};
-
-// The search for the first + to - crossing along origin + t * ray up to t_max (ray has z = 1
-// in camera space), one sample per step(): each sample's position depends on the one before, so
-// a ray is a chain of dependent loads, and a thread advances several rays in turn to overlap
-// their chains. start() begins (or begins again) at a given t.
-class RayMarch {
- public:
-  RayMarch() = default;
-  RayMarch(const Eigen::Vector3f& ray, float t_max, float voxel, float block)
-      : t_max_(t_max),
-        voxel_(voxel),
-        inverse_length_(1.0f / ray.norm()),
-        voxel_step_(voxel * inverse_length_),
-        block_step_(0.5f * block * inverse_length_) {}
-
-  void start(float t_min) {
-    state_ = State{};
-    state_.t = state_.fine_until = t_min;
-  }
-
-  // Takes the next sample; false once the march has ended (end() says how).
-  bool step(TsdfSampler& sampler, const Eigen::Vector3f& origin, const Eigen::Vector3f& ray) {
-    State& s = state_;
-    if (!(s.t <= t_max_)) return false;
-    const Eigen::Vector3f p = origin + ray * s.t;
-    float sdf;
-    TsdfSampler::Sample sample = sampler.nearest(p, sdf);
-    if (sample != TsdfSampler::Sample::unallocated && s.stride_start >= 0) {
-      if (sample == TsdfSampler::Sample::observed) {
-        s.fine_until = s.t;
-        s.t = s.stride_start + voxel_step_;
-        s.stride_start = -1;
-        return true;
-      }
-      s.stride_start = -1;
-    }
-    if (sample == TsdfSampler::Sample::unobserved && s.t >= s.fine_until) {
-      s.stride_start = s.t;
-      s.t += kUnobservedStride * voxel_step_;
-      s.previous_observed = false;
-      return true;
-    }
-    // Near the surface, the trilinear value (a voxel without all 8 neighbours observed counts
-    // as unobserved).
-    if (sample == TsdfSampler::Sample::observed && sdf < 2 * voxel_ && !sampler.trilinear(p, sdf))
-      sample = TsdfSampler::Sample::unobserved;
-    if (sample != TsdfSampler::Sample::observed) {
-      s.previous_observed = false;
-      s.t += sample == TsdfSampler::Sample::unallocated ? block_step_ : voxel_step_;
-      return true;
-    }
-    if (sdf < 0) {
-      // Entered behind a surface (a back face), or a crossing between two samples.
-      s.end = s.previous_observed
-                  ? MarchEnd{.t = s.previous_t +
-                                  (s.t - s.previous_t) * s.previous_sdf / (s.previous_sdf - sdf)}
-                  : MarchEnd{.back_face = true};
-      s.t = std::numeric_limits<float>::infinity();  // ended
-      return false;
-    }
-    s.previous_t = s.t;
-    s.previous_sdf = sdf;
-    s.previous_observed = true;
-    s.t += std::max(voxel_, 0.8f * sdf) * inverse_length_;
-    return true;
-  }
-
-  const MarchEnd& end() const { return state_.end; }
-
- private:
-  struct State {
-    float t = 0;
-    // The start of the last stride through unobserved voxels (-1: none), and where voxel steps
-    // end again after stepping back over it.
-    float stride_start = -1, fine_until = 0;
-    float previous_t = 0, previous_sdf = 0;
-    bool previous_observed = false;
-    MarchEnd end;
-  };
-  float t_max_ = -1;
-  float voxel_ = 0, inverse_length_ = 0, voxel_step_ = 0, block_step_ = 0;
-  State state_;
-};
 
 // One pixel's ray and its marches in turn until one finds the surface. With a hint d (the depth
 // just fused there), first from kHintLead voxels in front of d, where the model's surface lies;

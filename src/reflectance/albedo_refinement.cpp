@@ -140,7 +140,8 @@ std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int 
                                            const Eigen::Vector3f& normal,
                                            const std::vector<render::PointLight>& lights,
                                            const Eigen::Vector3f& ks, float alpha,
-                                           AlbedoAverage average, float saturated_radiance) {
+                                           AlbedoAverage average, float saturated_radiance,
+                                           const PointLighting& lighting) {
   // The observations seen from above the surface: their colours, and their directions as
   // arrays, for the batched lobe.
   std::array<Eigen::Vector3f, kMaxObservationsPerVoxel> colour;
@@ -168,11 +169,13 @@ std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int 
   std::array<Eigen::Vector3f, kMaxObservationsPerVoxel> specular;
   std::fill_n(specular.begin(), used, Eigen::Vector3f::Zero());
   std::array<float, kMaxObservationsPerVoxel> lobe;
-  Eigen::Vector3f diffuse = Eigen::Vector3f::Zero();  // sum_l L_l cos(theta_i,l)
-  float cosines = 0, sines = 0;                       // the same, luminance, and with sin
-  for (const render::PointLight& light : lights) {
-    const Incidence in = incidence(light, position, normal);
-    if (in.irradiance.isZero()) continue;  // the light is behind the surface
+  // sum_l L_l cos(theta_i,l) + E_ind, and the same as luminance and with sin: indirect light
+  // counts as if it came along the normal, where a normal error changes it least.
+  Eigen::Vector3f diffuse = lighting.indirect;
+  float cosines = lighting.indirect.mean(), sines = 0;
+  for (std::size_t l = 0; l < lights.size(); ++l) {
+    const Incidence in = incidence(lights, l, position, normal, lighting);
+    if (in.irradiance.isZero()) continue;  // the light is behind the surface or shadowed
     diffuse += in.irradiance;
     const float luminance = in.irradiance.mean();  // L_l cos(theta_i,l), mean over channels
     cosines += luminance;

@@ -4,8 +4,17 @@
 // eq. (6) for kd, eq. (7):
 //   kd = pi * (B_k - ks * sum_l exp(gamma_l) / N_l * L_l cos(theta_i,l)) / sum_l L_l cos(theta_i,l)
 // and the voxel's kd is the mean over its observations (the paper) or, more robustly, their
-// per-channel median. L_l = intensity_l / r_l^2 (near-field point lights); shadowing is
-// ignored, as in the paper.
+// per-channel median. L_l = intensity_l / r_l^2 (near-field point lights). Unlike the paper,
+// which ignores shadows and interreflections, the sums run over the lights that reach the voxel
+// (its shadow rays, reflectance/light_transport.h), and the irradiance in the denominator adds
+// the voxel's indirect irradiance E_ind gathered from the surfaces around it. With diffuse
+// interreflection the image model is
+//   B_k = kd / pi * (sum_l L_l cos(theta_i,l) + E_ind) + ks * sum_l exp(gamma_l) / N_l * ...
+// (the specular reflection of indirect light neglected), so kd is solved by dividing by the
+// total irradiance rather than by subtracting kd_current / pi * E_ind from B_k: that needs no
+// albedo estimate (which the subtraction would feed back on itself: a kd that is too bright
+// takes too much out), and it still gives an albedo where every light is shadowed and only
+// indirect light falls.
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
@@ -13,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "reflectance/light_incidence.h"
 #include "reflectance/observation.h"
 #include "render/scene.h"
 
@@ -46,18 +56,17 @@ inline float refined_albedo_weight(float light_tangent) {
 // The tangent of the angle whose cosine is `cosine` in [0, 1] (infinite at 0).
 inline float tangent_of(float cosine) { return std::sqrt(1 - cosine * cosine) / cosine; }
 
-// Eq. (7) over the voxel's observations (those seen from above the surface, at most
+// Eq. (7) over the voxel's observations under `lighting` (the lights that reach it, its
+// indirect irradiance) (those seen from above the surface, at most
 // kMaxObservationsPerVoxel), combined by `average`; nullopt when there is none or no light
 // reaches the surface point. Observations with a channel at `saturated_radiance` or above have
 // clipped: their albedo would come out too dark, so they are left out unless all of them clipped
 // (their albedo then a lower bound).
 // No allocation.
-std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int count,
-                                           const Eigen::Vector3f& position,
-                                           const Eigen::Vector3f& normal,
-                                           const std::vector<render::PointLight>& lights,
-                                           const Eigen::Vector3f& ks, float alpha,
-                                           AlbedoAverage average = AlbedoAverage::mean,
-                                           float saturated_radiance = INFINITY);
+std::optional<RefinedAlbedo> refine_albedo(
+    const Observation* observations, int count, const Eigen::Vector3f& position,
+    const Eigen::Vector3f& normal, const std::vector<render::PointLight>& lights,
+    const Eigen::Vector3f& ks, float alpha, AlbedoAverage average = AlbedoAverage::mean,
+    float saturated_radiance = INFINITY, const PointLighting& lighting = {});
 
 }  // namespace glint::reflectance

@@ -55,9 +55,10 @@ Eigen::Vector2f project_to_disk(const Eigen::Vector3f& d, HemiProjection project
 }
 
 Eigen::Vector3f hemi_input_scale(HemiInput input, const std::vector<render::PointLight>& lights,
-                                 const Eigen::Vector3f& position, const Eigen::Vector3f& normal) {
+                                 const Eigen::Vector3f& position, const Eigen::Vector3f& normal,
+                                 const PointLighting& lighting) {
   return input == HemiInput::radiance ? Eigen::Vector3f::Ones()
-                                      : reflectance_scale(lights, position, normal);
+                                      : reflectance_scale(lights, position, normal, lighting);
 }
 
 void make_hemi_image(const Observation* observations, int count, const Eigen::Vector3f& normal,

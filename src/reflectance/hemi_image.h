@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "reflectance/light_incidence.h"
 #include "reflectance/observation.h"
 #include "render/scene.h"
 
@@ -46,9 +47,11 @@ Eigen::Matrix3f local_frame(const Eigen::Vector3f& normal);
 Eigen::Vector2f project_to_disk(const Eigen::Vector3f& local_direction, HemiProjection projection);
 
 // The per-channel scale of a voxel's hemi-image for `input`: one for radiance,
-// reflectance_scale(lights, position, normal) (reflectance/light_incidence.h) for reflectance.
+// reflectance_scale(lights, position, normal, lighting) (reflectance/light_incidence.h) for
+// reflectance: the voxel's shadowed lights left out, its indirect irradiance added.
 Eigen::Vector3f hemi_input_scale(HemiInput input, const std::vector<render::PointLight>& lights,
-                                 const Eigen::Vector3f& position, const Eigen::Vector3f& normal);
+                                 const Eigen::Vector3f& position, const Eigen::Vector3f& normal,
+                                 const PointLighting& lighting = {});
 
 // Writes size*size*3 floats, channel-major (CHW) like the network's input, into `out`: each
 // pixel the colour of its nearest observation times `scale` per channel (HemiInput).

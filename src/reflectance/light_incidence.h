@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <vector>
 
@@ -30,23 +31,49 @@ inline Incidence incidence(const render::PointLight& light, const Eigen::Vector3
   return {wi, light.intensity * (cos_i / distance2), cos_i};
 }
 
+// What reaches one surface point besides the unoccluded point lights: which lights its shadow
+// rays found unblocked (bit l for lights[l]; lights from kMaxShadowedLights on are never
+// shadowed) and the indirect irradiance gathered from the surfaces around it
+// (reflectance/light_transport.h). The default is the paper's image model: every light reaches,
+// nothing else does.
+using LightMask = std::uint32_t;
+inline constexpr int kMaxShadowedLights = 32;
+inline constexpr LightMask kAllLights = ~LightMask{0};
+struct PointLighting {
+  LightMask lit = kAllLights;
+  Eigen::Vector3f indirect = Eigen::Vector3f::Zero();
+  bool reaches(std::size_t light) const {
+    return light >= std::size_t(kMaxShadowedLights) || (lit >> light & 1u);
+  }
+};
+
+// incidence() for lights[l], zero where `lighting` has it shadowed.
+inline Incidence incidence(const std::vector<render::PointLight>& lights, std::size_t l,
+                           const Eigen::Vector3f& position, const Eigen::Vector3f& normal,
+                           const PointLighting& lighting) {
+  if (!lighting.reaches(l)) return {};
+  return incidence(lights[l], position, normal);
+}
+
 // The irradiance share below which reflectance_scale floors a point's irradiance: a tenth of
 // what its lights would give it head-on (cos 84 deg), so that grazing and back-lit points'
 // radiances are amplified at most tenfold over a head-on lit one's.
 inline constexpr float kMinIrradianceShare = 0.1f;
 
-// pi / E per channel, E = sum_l L_l cos(theta_i,l) the lights' irradiance at a surface point
-// (unshadowed), floored at kMinIrradianceShare of sum_l L_l: radiance times this is the
-// point's apparent reflectance, where a Lambertian surface shows its albedo kd (eq. (6) with
-// ks = 0) whatever the lights. 0 in a channel no light emits.
+// pi / E per channel, E = sum_l L_l cos(theta_i,l) the irradiance at a surface point from the
+// lights `lighting` lets reach it, plus its indirect irradiance, floored at kMinIrradianceShare
+// of sum_l L_l over all lights: radiance times this is the point's apparent reflectance, where a
+// Lambertian surface shows its albedo kd (eq. (6) with ks = 0) whatever the lights. 0 in a
+// channel no light emits.
 inline Eigen::Vector3f reflectance_scale(const std::vector<render::PointLight>& lights,
                                          const Eigen::Vector3f& position,
-                                         const Eigen::Vector3f& normal) {
-  Eigen::Vector3f irradiance = Eigen::Vector3f::Zero(), head_on = Eigen::Vector3f::Zero();
-  for (const render::PointLight& light : lights) {
-    irradiance += incidence(light, position, normal).irradiance;
-    const float distance2 = (light.position.cast<float>() - position).squaredNorm();
-    if (distance2 > 0.0f) head_on += light.intensity / distance2;
+                                         const Eigen::Vector3f& normal,
+                                         const PointLighting& lighting = {}) {
+  Eigen::Vector3f irradiance = lighting.indirect, head_on = Eigen::Vector3f::Zero();
+  for (std::size_t l = 0; l < lights.size(); ++l) {
+    irradiance += incidence(lights, l, position, normal, lighting).irradiance;
+    const float distance2 = (lights[l].position.cast<float>() - position).squaredNorm();
+    if (distance2 > 0.0f) head_on += lights[l].intensity / distance2;
   }
   Eigen::Vector3f scale;
   for (int c = 0; c < 3; ++c) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "core/fast_exp.h"
@@ -13,12 +14,14 @@
 namespace glint::reflectance {
 
 WardShading ward_shading(float alpha, const Eigen::Vector3f& p, const Eigen::Vector3f& n,
-                         const Eigen::Vector3f& eye,
-                         const std::vector<render::PointLight>& lights) {
-  WardShading shading{Eigen::Vector3f::Zero(), Eigen::Vector3f::Zero()};
+                         const Eigen::Vector3f& eye, const std::vector<render::PointLight>& lights,
+                         const PointLighting& lighting) {
+  WardShading shading{lighting.indirect, Eigen::Vector3f::Zero()};
   const Eigen::Vector3f wo = (eye - p).normalized();
-  if (!(n.dot(wo) > 0.0f)) return shading;  // seen from behind: no light leaves towards the eye
-  for (const render::PointLight& light : lights) {
+  if (!(n.dot(wo) > 0.0f)) return {Eigen::Vector3f::Zero(), Eigen::Vector3f::Zero()};
+  for (std::size_t l = 0; l < lights.size(); ++l) {
+    if (!lighting.reaches(l)) continue;
+    const render::PointLight& light = lights[l];
     const Eigen::Vector3f to_light = light.position.cast<float>() - p;
     const float distance2 = to_light.squaredNorm();
     if (!(distance2 > 0)) continue;
@@ -372,7 +375,8 @@ void clear_row(Image<T>& image, int y) {
 void render_material_maps(const fusion::SurfaceView& surface, const Pose& camera_to_world,
                           const ObservationGrid& grid, const SpecularEstimator& materials,
                           const std::vector<render::PointLight>& lights, float exposure,
-                          const AlbedoBlend& blend, MaterialMaps& maps) {
+                          const AlbedoBlend& blend, MaterialMaps& maps,
+                          const LightTransport* transport, const fusion::TsdfVolume* volume) {
   const int width = surface.depth_m.width(), height = surface.depth_m.height();
   // The float maps and their channels.
   const std::array<std::pair<ImageF*, int>, 7> float_maps{{{&maps.kd, 3},
@@ -385,11 +389,16 @@ void render_material_maps(const fusion::SurfaceView& surface, const Pose& camera
   for (const auto& [image, channels] : float_maps) image->ensure_size(width, height, channels);
   maps.segment.ensure_size(width, height, 1);
   const Eigen::Vector3f eye = camera_to_world.translation().cast<float>();
+  const bool lit = transport && volume && transport->enabled();
+  const std::optional<fusion::BlockOccupancy> occupancy =
+      lit ? std::optional<fusion::BlockOccupancy>(*volume) : std::nullopt;
   parallel_for(std::size_t(height), [&](std::size_t row) {
     const int y = int(row);
     for (const auto& [image, channels] : float_maps) clear_row(*image, y);
     clear_row(maps.segment, y);
     MaterialLookup lookup(grid, materials, blend);
+    std::optional<PointLightingQuery> lighting;
+    if (lit) lighting.emplace(*transport, grid, *volume, *occupancy, lights);
     for (int x = 0; x < width; ++x) {
       if (!(surface.depth_m.at(x, y, 0) > 0)) continue;
       const Eigen::Vector3f p(surface.points_m.at(x, y, 0), surface.points_m.at(x, y, 1),
@@ -409,7 +418,8 @@ void render_material_maps(const fusion::SurfaceView& surface, const Pose& camera
         return (radiance * exposure).cwiseMax(0.0f).cwiseMin(1.0f).eval();
       };
       // The two materials differ in kd only: one shading serves both.
-      const WardShading shading = ward_shading(material.fused.alpha, p, n, eye, lights);
+      const WardShading shading = ward_shading(material.fused.alpha, p, n, eye, lights,
+                                               lighting ? (*lighting)(p, n) : PointLighting{});
       put(maps.rgb, x, y, pixel(shading.radiance(material.fused)));
       put(maps.rgb_refined, x, y, pixel(shading.radiance(material.refined)));
     }

@@ -40,8 +40,11 @@ struct WardShading {
     return (material.kd / float(M_PI)).cwiseProduct(diffuse) + material.ks.cwiseProduct(specular);
   }
 };
+// With `lighting`, only the lights it lets reach p count, and its indirect irradiance adds to
+// diffuse (its specular reflection neglected, as in the albedo refinement's image model).
 WardShading ward_shading(float alpha, const Eigen::Vector3f& p, const Eigen::Vector3f& n,
-                         const Eigen::Vector3f& eye, const std::vector<render::PointLight>& lights);
+                         const Eigen::Vector3f& eye, const std::vector<render::PointLight>& lights,
+                         const PointLighting& lighting = {});
 
 // How the voxels' refined albedos around a point are blended (interpolate_refined_kd()).
 struct AlbedoBlend {
@@ -156,9 +159,13 @@ class MaterialLookup {
 // Fills `maps` (0 where the model was not hit or has no material). Images of the view's size
 // keep their storage: a caller rendering view after view passes the same maps, and their 15 MB
 // (512 x 424) are not allocated and faulted in afresh, 6 ms of each re-rendering on one core.
+// With `transport` (and the `volume` it was cast through) the re-rendering casts shadows, a
+// shadow ray per pixel and light, and adds the indirect light of the voxel under each pixel.
 void render_material_maps(const fusion::SurfaceView& surface, const Pose& camera_to_world,
                           const ObservationGrid& grid, const SpecularEstimator& materials,
                           const std::vector<render::PointLight>& lights, float exposure,
-                          const AlbedoBlend& blend, MaterialMaps& maps);
+                          const AlbedoBlend& blend, MaterialMaps& maps,
+                          const LightTransport* transport = nullptr,
+                          const fusion::TsdfVolume* volume = nullptr);
 
 }  // namespace glint::reflectance

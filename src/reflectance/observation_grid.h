@@ -100,6 +100,8 @@ class ObservationGrid {
   const ObservationGridParams& params() const { return params_; }
   int voxels_per_block_side() const { return side_; }
   std::size_t voxel_count() const { return hash_.size() * voxels_per_block_; }
+  // The pools' size: every pool index is below it (per-voxel data kept elsewhere is sized so).
+  std::size_t voxel_pool_size() const { return hash_.capacity() * voxels_per_block_; }
   std::size_t block_count() const { return hash_.size(); }
 
   // One frame: depth in metres (0 = none), linear RGB colour of the same size, the frame's pose,

@@ -50,7 +50,8 @@ void render_model(const ReflectancePipeline& pipeline, const Intrinsics& intrins
   }
   watch.restart();
   render_material_maps(view, pose, pipeline.observations(), pipeline.materials(), pipeline.lights(),
-                       pipeline.exposure(), pipeline.albedo_blend(), maps);
+                       pipeline.exposure(), pipeline.albedo_blend(), maps,
+                       &pipeline.light_transport(), &pipeline.geometry());
   timings.add("shade", watch.elapsed_ms());
 }
 

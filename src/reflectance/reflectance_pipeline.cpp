@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "fusion/block_occupancy.h"
 #include "fusion/depth_maps.h"
 #include "reflectance/albedo_refinement.h"
 
@@ -22,6 +23,12 @@ float saturated_radiance(float exposure) { return 0.99f / exposure; }
 // The lobe fit leaves out clipped observations (or takes them as bounds).
 SpecularParams with_saturation(SpecularParams params, float exposure) {
   params.fit.saturated_radiance = saturated_radiance(exposure);
+  return params;
+}
+
+// Clipped emitters count as dark in the indirect gather.
+LightTransportParams with_saturation(LightTransportParams params, float exposure) {
+  params.saturated_radiance = saturated_radiance(exposure);
   return params;
 }
 
@@ -45,6 +52,7 @@ ReflectancePipeline::ReflectancePipeline(const Intrinsics& intrinsics,
       segment_map_(params.segments),
       depth_segmenter_(halved_segmentation_params(params)),
       specular_(network, with_saturation(params.specular, params.exposure)),
+      transport_(with_saturation(params.light_transport, params.exposure), grid_.voxel_pool_size()),
       lights_(std::move(lights)) {
   if (params.albedo_refresh_frames < 1)
     throw Error("reflectance pipeline", "albedo_refresh_frames", "must be >= 1");
@@ -91,9 +99,10 @@ void ReflectancePipeline::refine_albedo_of_visible() {
       const int segment = grid_.segment(v);
       const SegmentMaterial* material = specular_.material(segment);
       if (!material) continue;
-      const auto refined = refine_albedo(
-          grid_.observations(v), grid_.observation_count(v), grid_.position(v), grid_.normal(v),
-          lights_, material->ward.ks, material->ward.alpha, params_.albedo_average, clipped);
+      const auto refined =
+          refine_albedo(grid_.observations(v), grid_.observation_count(v), grid_.position(v),
+                        grid_.normal(v), lights_, material->ward.ks, material->ward.alpha,
+                        params_.albedo_average, clipped, transport_.lighting(v));
       // Each voxel is written by one iteration only: the due list holds it once.
       grid_.has_refined_kd(v) = refined.has_value();
       if (!refined) continue;
@@ -170,7 +179,17 @@ ReflectanceFrame ReflectancePipeline::process(const io::RgbdFrame& frame,
   timings_.add("segmentation", stage.elapsed_ms());
 
   stage.restart();
-  specular_.update(grid_, segment_map_, segment_map_.frame_segments(), lights_, frame_);
+  if (transport_.enabled()) {
+    const fusion::BlockOccupancy occupancy(geometry_.volume());
+    transport_.update_shadows(grid_, geometry_.volume(), occupancy, lights_, frame_);
+    timings_.add("shadows", stage.elapsed_ms());
+    stage.restart();
+    transport_.update_indirect(grid_, geometry_.volume(), occupancy, lights_, frame_);
+    timings_.add("indirect", stage.elapsed_ms());
+    stage.restart();
+  }
+  specular_.update(grid_, segment_map_, segment_map_.frame_segments(), lights_, frame_,
+                   &transport_);
   timings_.add("specular", stage.elapsed_ms());
 
   stage.restart();

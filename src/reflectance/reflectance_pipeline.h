@@ -5,9 +5,15 @@
 //   segmentation  per-frame depth segmentation, propagated to global segment ids (§3.5), or
 //                 the sequence's ground-truth segment ids
 //   specular      HemiCNN per segment on 25 sampled voxels, fused over time (§3.6)
+//   shadows       which lights reach each seen voxel, by shadow rays through the TSDF (glint's
+//                 addition, reflectance/light_transport.h)
+//   indirect      each seen voxel's indirect irradiance, gathered from the observed radiance
+//                 of the surfaces around it (glint's addition, the same header)
+//   specular      HemiCNN per segment on 25 sampled voxels, fused over time (§3.6)
 //   albedo        per-voxel diffuse albedo from eq. (7) with the segment's ks, alpha (§3.7)
-// Stage times go into timings() as "geometry", "observations", "segmentation", "specular",
-// "albedo" and "total" (milliseconds per frame), the rows of paper 1 Tables 2-3.
+// Stage times go into timings() as "geometry", "observations", "segmentation", "shadows",
+// "indirect", "specular", "albedo" and "total" (milliseconds per frame), the rows of paper 1
+// Tables 2-3 and glint's two.
 #include <vector>
 
 #include "core/timer.h"
@@ -16,6 +22,7 @@
 #include "reflectance/albedo_refinement.h"
 #include "reflectance/depth_segmentation.h"
 #include "reflectance/hemicnn.h"
+#include "reflectance/light_transport.h"
 #include "reflectance/material_maps.h"
 #include "reflectance/observation_grid.h"
 #include "reflectance/reflectance_volume.h"
@@ -37,6 +44,9 @@ struct ReflectanceParams {
   // and smoother normals on noisy sensors; voxels look their label up at the coarser pixel.
   int segmentation_halvings = 1;
   SegmentMapParams segments;
+  // Shadows and interreflections: eq. (7), the hemi-images and the lobe fit count only the
+  // lights that reach a voxel, and its indirect irradiance (reflectance/light_transport.h).
+  LightTransportParams light_transport;
   SpecularParams specular;
   // Each visible voxel's albedo is re-solved every this many frames (staggered over the voxels;
   // a voxel without one is solved at once): one new observation of up to 30 moves the mean
@@ -91,6 +101,7 @@ class ReflectancePipeline {
   const ObservationGrid& observations() const { return grid_; }
   const SegmentMap& segments() const { return segment_map_; }
   const SpecularEstimator& materials() const { return specular_; }
+  const LightTransport& light_transport() const { return transport_; }
   const std::vector<render::PointLight>& lights() const { return lights_; }
   const StageTimings& timings() const { return timings_; }
   // The geometry stage's parts: "track", "raycast" (the model tracking aligns to; both only
@@ -124,6 +135,7 @@ class ReflectancePipeline {
   DepthSegmenter depth_segmenter_;    // at the resolution segmentation_halvings gives
   Image<std::int32_t> frame_labels_;  // scratch of segment_frame()
   SpecularEstimator specular_;
+  LightTransport transport_;
   std::vector<render::PointLight> lights_;
   StageTimings timings_;
   std::vector<int> albedo_due_;  // scratch of refine_albedo_of_visible()

@@ -63,7 +63,11 @@ void SpecularEstimator::fuse_refined_albedo(int segment, const Eigen::Vector3f& 
 
 void SpecularEstimator::update(const ObservationGrid& grid, const SegmentMap& segment_map,
                                const std::vector<int>& segments,
-                               const std::vector<render::PointLight>& lights, int frame) {
+                               const std::vector<render::PointLight>& lights, int frame,
+                               const LightTransport* transport) {
+  const auto lighting = [transport](int v) {
+    return transport ? transport->lighting(v) : PointLighting{};
+  };
   const int count = params_.voxels_per_estimate;
   const int image_floats = 3 * hemi_.size * hemi_.size;
   std::vector<std::optional<render::WardMaterial>> estimates(segments.size());
@@ -86,7 +90,7 @@ void SpecularEstimator::update(const ObservationGrid& grid, const SegmentMap& se
     for (int k = 0; k < sampled; ++k) {
       const int v = voxels[k];
       const Eigen::Vector3f scale =
-          hemi_input_scale(network_.input(), lights, grid.position(v), grid.normal(v));
+          hemi_input_scale(network_.input(), lights, grid.position(v), grid.normal(v), lighting(v));
       make_hemi_image(grid.observations(v), grid.observation_count(v), grid.normal(v), hemi_,
                       images.data() + std::size_t(k) * image_floats, scale);
     }
@@ -99,7 +103,7 @@ void SpecularEstimator::update(const ObservationGrid& grid, const SegmentMap& se
     std::vector<FitVoxel> fit_voxels(count);
     for (int k = 0; k < count; ++k)
       fit_voxels[k] = {grid.observations(voxels[k]), grid.observation_count(voxels[k]),
-                       grid.position(voxels[k]), grid.normal(voxels[k])};
+                       grid.position(voxels[k]), grid.normal(voxels[k]), lighting(voxels[k])};
     fits[i] = fit_specular(fit_voxels, lights, params_.fit);
   });
   for (std::size_t i = 0; i < segments.size(); ++i) {

@@ -17,6 +17,7 @@
 
 #include "reflectance/hemi_image.h"
 #include "reflectance/hemicnn.h"
+#include "reflectance/light_transport.h"
 #include "reflectance/material_fusion.h"
 #include "reflectance/observation_grid.h"
 #include "reflectance/segment_map.h"
@@ -60,10 +61,11 @@ class SpecularEstimator {
   SpecularEstimator(const HemiCnn& network, const SpecularParams& params = {});
 
   // Estimates every segment in `segments` that has enough sampled voxels, and fuses. `lights`
-  // are those of the scene, for the lobe fit.
+  // are those of the scene, for the reflectance hemi-images and the lobe fit; `transport`, where
+  // given, says which of them reach each voxel and its indirect irradiance.
   void update(const ObservationGrid& grid, const SegmentMap& segment_map,
               const std::vector<int>& segments, const std::vector<render::PointLight>& lights,
-              int frame);
+              int frame, const LightTransport* transport = nullptr);
 
   // Fuses one frame's refined albedo of `segment` into its SegmentMaterial::kd_refined; ignored
   // for a segment without a material yet.

@@ -67,8 +67,8 @@ void LobeProblem::add_voxel(const FitVoxel& voxel, const std::vector<render::Poi
   // Beyond it the lobe is below exp(-40) of its peak at every alpha searched.
   const float negligible_tan2 = 40.0f * params.alpha_max * params.alpha_max;
   lit_.clear();  // the lights above the voxel's surface, once per voxel
-  for (const render::PointLight& light : lights)
-    if (const Incidence in = incidence(light, voxel.position, voxel.normal);
+  for (std::size_t l = 0; l < lights.size(); ++l)
+    if (const Incidence in = incidence(lights, l, voxel.position, voxel.normal, voxel.lighting);
         in.cosine > render::kGrazingCosine)
       lit_.push_back(in);
   const std::size_t first = centred_colour_.size(), first_term = tan2_.size();

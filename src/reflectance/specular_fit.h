@@ -16,6 +16,7 @@
 #include <optional>
 #include <vector>
 
+#include "reflectance/light_incidence.h"
 #include "reflectance/observation.h"
 #include "render/scene.h"
 
@@ -37,12 +38,15 @@ struct SpecularFitParams {
   bool clipped_as_bounds = true;
 };
 
-// One voxel's stored observations and its surface point.
+// One voxel's stored observations, its surface point and the lights that reach it (a shadowed
+// light casts no highlight; the indirect light's diffuse part is the same for every observation
+// of the voxel, so the fit's centring removes it).
 struct FitVoxel {
   const Observation* observations = nullptr;
   int count = 0;
   Eigen::Vector3f position = Eigen::Vector3f::Zero();
   Eigen::Vector3f normal = Eigen::Vector3f::UnitZ();
+  PointLighting lighting;
 };
 
 struct SpecularFit {

@@ -221,5 +221,64 @@ TEST(AlbedoRefinement, UnlitOrUnseenVoxelsHaveNoEstimate) {
   EXPECT_FALSE(refine_albedo(&o, 1, Eigen::Vector3f::Zero(), normal, above, {0, 0, 0}, 0.1f));
 }
 
+// Observed radiance = kd / pi * (E_direct + E_indirect) + specular, with E_direct over the
+// lights that reach the voxel: eq. (7) divides by that total and recovers kd, where the paper's
+// division by every light's irradiance reads a shadowed, indirectly lit voxel far too dark.
+TEST(AlbedoRefinement, ShadowedLightsAndIndirectLightAreTakenOutOfEquationSeven) {
+  render::WardMaterial m;
+  m.kd = {0.6f, 0.3f, 0.1f};
+  m.ks = {0.2f, 0.2f, 0.2f};
+  m.alpha = 0.1f;
+  std::vector<render::PointLight> lights(2);
+  lights[0].position = {0.5, 2.0, 0.3};
+  lights[0].intensity = {3, 3, 3};
+  lights[1].position = {-1.0, 1.5, -0.5};
+  lights[1].intensity = {2, 2, 2};
+  const Eigen::Vector3f position(0.1f, 0.0f, 0.2f), normal = Eigen::Vector3f::UnitY();
+  const PointLighting lighting{.lit = kAllLights & ~LightMask{2},  // light 1 shadowed
+                               .indirect = Eigen::Vector3f(0.4f, 0.3f, 0.2f)};
+  const std::vector<render::PointLight> reaching{lights[0]};
+  std::vector<Observation> obs;
+  for (int k = 0; k < 10; ++k) {
+    const Eigen::Vector3f direction =
+        Eigen::Vector3f(std::cos(0.6f * k), 0.5f + 0.1f * k, std::sin(0.6f * k)).normalized();
+    const Eigen::Vector3f seen = observed(m, position, normal, direction, reaching) +
+                                 m.kd.cwiseProduct(lighting.indirect) / float(M_PI);
+    obs.emplace_back(seen, direction, k);
+  }
+  const auto refined = refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks,
+                                     m.alpha, AlbedoAverage::median, INFINITY, lighting);
+  ASSERT_TRUE(refined.has_value());
+  EXPECT_TRUE(refined->kd.isApprox(m.kd, 2e-3f)) << refined->kd.transpose();
+  // Leaving the indirect light out reads the albedo too bright; the shadow, too dark.
+  const auto direct_only =
+      refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks, m.alpha,
+                    AlbedoAverage::median, INFINITY, PointLighting{.lit = lighting.lit});
+  EXPECT_GT(direct_only->kd.x(), 1.1f * m.kd.x());
+  const auto unshadowed =
+      refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks, m.alpha,
+                    AlbedoAverage::median, INFINITY, PointLighting{.indirect = lighting.indirect});
+  EXPECT_LT(unshadowed->kd.x(), 0.9f * m.kd.x());
+
+  // Every light shadowed: the indirect light alone gives the albedo.
+  const PointLighting dark{.lit = 0, .indirect = Eigen::Vector3f(0.4f, 0.3f, 0.2f)};
+  std::vector<Observation> unlit;
+  for (int k = 0; k < 5; ++k) {
+    const Eigen::Vector3f direction =
+        Eigen::Vector3f(std::cos(0.6f * k), 0.5f, std::sin(0.6f * k)).normalized();
+    unlit.emplace_back(m.kd.cwiseProduct(dark.indirect) / float(M_PI), direction, k);
+  }
+  const auto from_indirect =
+      refine_albedo(unlit.data(), int(unlit.size()), position, normal, lights, m.ks, m.alpha,
+                    AlbedoAverage::mean, INFINITY, dark);
+  ASSERT_TRUE(from_indirect.has_value());
+  EXPECT_TRUE(from_indirect->kd.isApprox(m.kd, 2e-3f)) << from_indirect->kd.transpose();
+  EXPECT_FLOAT_EQ(from_indirect->light_cosine(), 1.0f);  // indirect light counts as head-on
+  // Neither direct nor indirect light: no estimate.
+  EXPECT_FALSE(refine_albedo(unlit.data(), int(unlit.size()), position, normal, lights, m.ks,
+                             m.alpha, AlbedoAverage::mean, INFINITY, PointLighting{.lit = 0})
+                   .has_value());
+}
+
 }  // namespace
 }  // namespace glint::reflectance

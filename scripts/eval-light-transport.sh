@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# Shadows and interreflections in the reflectance pipeline (reflectance/light_transport.h).
+# Renders each scene three ways (FRAMES frames, 512x424):
+#   a  direct light without shadows (the input of eval-reflectance.sh),
+#   b  direct light with shadows (the renderer's default),
+#   c  shadows and BOUNCES bounces of indirect light (`glint synth --bounces`; skipped where the
+#      binary has no such option and OUT/seq-SCENE-c is not there already),
+# estimates the lights once per scene from its light capture (glint lights), and reconstructs
+# each rendering with glint's own segmentation, ground-truth poses and 2 cm observation voxels,
+# scored every 10th frame against the ground truth:
+#   before    the defaults, --shadows off --indirect off (the paper's image model),
+#   after     --shadows on,
+#   indirect  --shadows on --indirect on,
+# plus, for the timing tables, the "indirect" settings on each rendering b at 1 cm and 2 cm with
+# ground-truth segmentation (TIMING_SCENES). Reports: OUT/<scene>-<render>-<variant>.json;
+# summary: OUT/summary.md (scripts/light-transport-summary.py).
+#   scripts/eval-light-transport.sh GLINT DATA [OUT] [SCENES] [FRAMES] [TIMING_SCENES]
+set -euo pipefail
+GLINT=${1:?usage: eval-light-transport.sh GLINT DATA [OUT] [SCENES] [FRAMES] [TIMING_SCENES]}
+DATA=${2:?usage: eval-light-transport.sh GLINT DATA [OUT] [SCENES] [FRAMES] [TIMING_SCENES]}
+OUT=${3:-build/eval-light-transport}
+SCENES=${4:-bunnies office}
+FRAMES=${5:-300}
+TIMING_SCENES=${6:-cubes bunnies office}
+BOUNCES=${BOUNCES:-3}
+MODEL=$(dirname "$0")/../models/hemicnn.json
+mkdir -p "$OUT"
+render() {  # render SCENE R: OUT/seq-SCENE-R
+  local scene=$1 r=$2 seq="$OUT/seq-$1-$2"
+  [[ -d "$seq" ]] && return 0
+  case $r in
+    a) "$GLINT" --quiet synth "$scene" -o "$seq" --frames "$FRAMES" --no-shadows --data "$DATA" ;;
+    b) "$GLINT" --quiet synth "$scene" -o "$seq" --frames "$FRAMES" --data "$DATA" ;;
+    c) if "$GLINT" synth --help | grep -q -- --bounces; then
+         "$GLINT" --quiet synth "$scene" -o "$seq" --frames "$FRAMES" --bounces "$BOUNCES" \
+           --data "$DATA"
+       else
+         echo "eval-light-transport: $GLINT has no synth --bounces; skipping $seq" >&2
+         return 1
+       fi ;;
+  esac
+}
+lights() {  # lights SCENE: OUT/lights-SCENE.json
+  local scene=$1
+  [[ -d "$OUT/capture-$scene" ]] ||
+    "$GLINT" --quiet synth lights --scene "$scene" -o "$OUT/capture-$scene" --frames 60 \
+      --data "$DATA"
+  [[ -f "$OUT/lights-$scene.json" ]] ||
+    "$GLINT" --quiet lights "$OUT/capture-$scene" -o "$OUT/lights-$scene.json"
+}
+reconstruct() {  # reconstruct SCENE R NAME ARGS...
+  local scene=$1 r=$2 name=$3
+  shift 3
+  [[ -f "$OUT/$scene-$r-$name.json" ]] && return 0  # done in an earlier run
+  "$GLINT" --quiet reconstruct "$OUT/seq-$scene-$r" --lights "$OUT/lights-$scene.json" \
+    --gt-poses --model "$MODEL" -o "$OUT/$scene-$r-$name" --report "$OUT/$scene-$r-$name.json" \
+    "$@" > "$OUT/$scene-$r-$name.txt"
+}
+for scene in $SCENES; do
+  lights "$scene"
+  for r in a b c; do
+    render "$scene" "$r" || continue
+    reconstruct "$scene" "$r" before --shadows off --indirect off --eval-every 10
+    reconstruct "$scene" "$r" after --shadows on --eval-every 10
+    reconstruct "$scene" "$r" indirect --shadows on --indirect on --eval-every 10
+  done
+done
+for scene in $TIMING_SCENES; do
+  lights "$scene"
+  render "$scene" b
+  reconstruct "$scene" b timing-2cm --gt-segmentation --shadows on --indirect on --eval-every 0
+  reconstruct "$scene" b timing-1cm --gt-segmentation --shadows on --indirect on \
+    --obs-voxel 0.01 --eval-every 0
+done
+python3 "$(dirname "$0")/light-transport-summary.py" "$OUT" > "$OUT/summary.md"
+echo "eval-light-transport: reports in $OUT, summary in $OUT/summary.md"

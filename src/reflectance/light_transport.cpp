@@ -1,0 +1,230 @@
+#include "reflectance/light_transport.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "core/error.h"
+#include "core/parallel.h"
+#include "fusion/ray_march.h"
+#include "reflectance/hemi_image.h"
+
+namespace glint::reflectance {
+namespace {
+
+// SplitMix64's finaliser: a voxel's grid coordinates and the seed to its sequence's offset.
+std::uint64_t mix(std::uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+float fraction(float x) { return x - std::floor(x); }
+
+// The box of the allocated blocks in metres, and where a ray from inside it leaves it.
+struct WorldBox {
+  bool known = false;
+  Eigen::Vector3f low, high;
+  WorldBox(const fusion::BlockOccupancy& occupancy, const fusion::TsdfVolume& volume) {
+    Eigen::Vector3i low_block, high_block;
+    if (!occupancy.bounds(low_block, high_block)) return;
+    const float block = float(volume.params().block_size_m());
+    low = low_block.cast<float>() * block;
+    high = (high_block + Eigen::Vector3i::Ones()).cast<float>() * block;
+    known = true;
+  }
+  float exit(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction) const {
+    float t = INFINITY;
+    if (!known) return t;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (direction[axis] > 0) t = std::min(t, (high[axis] - origin[axis]) / direction[axis]);
+      if (direction[axis] < 0) t = std::min(t, (low[axis] - origin[axis]) / direction[axis]);
+    }
+    return std::max(t, 0.0f);
+  }
+};
+
+// Under the diffuse assumption the radiance voxel u sends every way: the colour of its
+// observation of median luminance (its highlights, seen from few directions, lie above it).
+bool diffuse_radiance(const ObservationGrid& grid, int u, Eigen::Vector3f& radiance) {
+  const int count = std::min(grid.observation_count(u), kMaxObservationsPerVoxel);
+  if (count == 0) return false;
+  const Observation* observations = grid.observations(u);
+  std::array<std::pair<float, int>, kMaxObservationsPerVoxel> luminance;
+  for (int k = 0; k < count; ++k) luminance[std::size_t(k)] = {observations[k].colour().mean(), k};
+  std::nth_element(luminance.begin(), luminance.begin() + count / 2, luminance.begin() + count);
+  radiance = observations[luminance[std::size_t(count / 2)].second].colour();
+  return true;
+}
+
+// The observed radiance at ray hit h (the ray along unit d): the voxel holding h, or, where that
+// has no observations (h lies on a voxel face), the one half a voxel back along the ray. False
+// where neither has any.
+bool hit_radiance(const ObservationGrid& grid, const Eigen::Vector3f& h, const Eigen::Vector3f& d,
+                  ObservationGrid::BlockCache& blocks, Eigen::Vector3f& radiance) {
+  for (const float back : {0.0f, 0.5f}) {
+    const int u = grid.find(h - d * (back * float(grid.params().voxel_size_m)), &blocks);
+    if (u >= 0 && diffuse_radiance(grid, u, radiance)) return true;
+  }
+  return false;
+}
+
+// Whether h lies on the proxy sphere of one of the lights: its direct light is already counted.
+bool on_light(const std::vector<render::PointLight>& lights, const Eigen::Vector3f& h,
+              float margin) {
+  for (const render::PointLight& light : lights)
+    if ((light.position.cast<float>() - h).norm() <= float(light.proxy_radius_m) + margin)
+      return true;
+  return false;
+}
+
+// The end of a shadow ray short of the light (its proxy and a margin of two TSDF voxels).
+float shadow_ray_end(const render::PointLight& light, float distance,
+                     const fusion::TsdfVolume& volume) {
+  return distance - float(light.proxy_radius_m) - 2 * float(volume.params().voxel_size_m);
+}
+
+}  // namespace
+
+LightTransport::LightTransport(const LightTransportParams& params, std::size_t voxel_capacity)
+    : params_(params) {
+  const auto positive = [](int value, const char* field) {
+    if (value < 1) throw Error("light transport", field, "must be >= 1");
+  };
+  positive(params.shadow_refresh_frames, "shadow_refresh_frames");
+  positive(params.indirect_rays, "indirect_rays");
+  positive(params.indirect_rays_per_frame, "indirect_rays_per_frame");
+  positive(params.indirect_refresh_frames, "indirect_refresh_frames");
+  positive(params.indirect_every_frames, "indirect_every_frames");
+  if (params.indirect_rays > 65535)
+    throw Error("light transport", "indirect_rays", "must be <= 65535");
+  if (params.indirect_min_rays < 0 || params.indirect_min_rays > params.indirect_rays)
+    throw Error("light transport", "indirect_min_rays", "must be in [0, indirect_rays]");
+  if (!(params.ray_offset_m >= 0 && std::isfinite(params.ray_offset_m)))
+    throw Error("light transport", "ray_offset_m", "must be finite and >= 0");
+  if (!(params.indirect_max_distance_m > 0))
+    throw Error("light transport", "indirect_max_distance_m", "must be > 0");
+  if (!enabled()) return;  // no pools: lighting() answers from the parameters alone
+  lit_ = make_pool<LightMask>(voxel_capacity, "light transport visibility");
+  shadow_cast_ = make_pool<bool>(voxel_capacity, "light transport visibility");
+  indirect_sum_ = make_pool<Eigen::Vector3f>(voxel_capacity, "light transport indirect");
+  indirect_rays_ = make_pool<std::uint16_t>(voxel_capacity, "light transport indirect");
+  indirect_next_ = make_pool<std::uint32_t>(voxel_capacity, "light transport indirect");
+}
+
+LightMask shadow_mask(fusion::TsdfSampler& sampler, const fusion::TsdfVolume& volume,
+                      const std::vector<render::PointLight>& lights, const Eigen::Vector3f& p,
+                      const Eigen::Vector3f& n, float offset_m) {
+  LightMask mask = kAllLights;
+  const Eigen::Vector3f origin = p + offset_m * n;
+  const std::size_t shadowed = std::min(lights.size(), std::size_t(kMaxShadowedLights));
+  for (std::size_t l = 0; l < shadowed; ++l) {
+    const Eigen::Vector3f to_light = lights[l].position.cast<float>() - origin;
+    if (!(n.dot(to_light) > 0)) continue;  // behind the surface: it gets no light anyway
+    const float distance = to_light.norm();
+    const float t_max = shadow_ray_end(lights[l], distance, volume);
+    if (!(t_max > 0)) continue;
+    const fusion::MarchEnd end =
+        fusion::first_surface(sampler, volume, origin, to_light / distance, 0.0f, t_max);
+    if (end.t > 0 || end.back_face) mask &= ~(LightMask{1} << l);
+  }
+  return mask;
+}
+
+void LightTransport::update_shadows(const ObservationGrid& grid, const fusion::TsdfVolume& volume,
+                                    const fusion::BlockOccupancy& occupancy,
+                                    const std::vector<render::PointLight>& lights, int frame) {
+  if (!params_.shadows) return;
+  due_.clear();
+  for (const VisibleVoxel& seen : grid.visible())
+    if (grid.has_surface(seen.voxel) &&
+        (!shadow_cast_[seen.voxel] || (seen.voxel + frame) % params_.shadow_refresh_frames == 0))
+      due_.push_back(seen.voxel);
+  parallel_for_chunks(due_.size(), 16, [&](std::size_t begin, std::size_t end) {
+    fusion::TsdfSampler sampler(volume, &occupancy);
+    for (std::size_t i = begin; i < end; ++i) {
+      const int v = due_[i];
+      lit_[v] = shadow_mask(sampler, volume, lights, grid.position(v), grid.normal(v),
+                            params_.ray_offset_m);
+      shadow_cast_[v] = true;
+    }
+  });
+}
+
+void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::TsdfVolume& volume,
+                                     const fusion::BlockOccupancy& occupancy,
+                                     const std::vector<render::PointLight>& lights, int frame) {
+  if (!params_.indirect) return;
+  const int n = params_.indirect_rays;
+  due_.clear();
+  for (const VisibleVoxel& seen : grid.visible())
+    if (grid.has_surface(seen.voxel) &&
+        (seen.voxel + frame) % (indirect_rays_[seen.voxel] < n ? params_.indirect_every_frames
+                                                               : params_.indirect_refresh_frames) ==
+            0)
+      due_.push_back(seen.voxel);
+  const WorldBox box(occupancy, volume);
+  // A hit this close to a light's proxy lies on it, or in an observation voxel it shares.
+  const float margin = 2 * float(grid.params().voxel_size_m);
+  // The additive recurrence of the plastic number (Roberts' R2 sequence): low-discrepancy in
+  // [0, 1)^2 for any number of points, so a voxel's directions stratify however many it has
+  // been given; each voxel's sequence is shifted (Cranley-Patterson) by a hash of its place.
+  constexpr float kR2a = 0.75487766624669276f, kR2b = 0.56984029099805327f;
+  parallel_for_chunks(due_.size(), 16, [&](std::size_t begin, std::size_t end) {
+    fusion::TsdfSampler sampler(volume, &occupancy);
+    ObservationGrid::BlockCache blocks;
+    for (std::size_t i = begin; i < end; ++i) {
+      const int v = due_[i];
+      const Eigen::Vector3f& normal = grid.normal(v);
+      const Eigen::Matrix3f to_world = local_frame(normal).transpose();
+      const Eigen::Vector3f origin = grid.position(v) + params_.ray_offset_m * normal;
+      const Eigen::Vector3i place = grid.voxel_coordinates(v);
+      const std::uint64_t hash =
+          mix(params_.seed ^ mix(std::uint64_t(std::uint32_t(place.x())) ^
+                                 std::uint64_t(std::uint32_t(place.y())) << 21 ^
+                                 std::uint64_t(std::uint32_t(place.z())) << 42));
+      const float shift_a = float(hash >> 40) * 0x1p-24f;
+      const float shift_b = float((hash >> 16) & 0xFFFFFF) * 0x1p-24f;
+      const int rays = indirect_rays_[v] < n ? params_.indirect_rays_per_frame : 1;
+      for (int k = 0; k < rays; ++k) {
+        const float index = float(indirect_next_[v]++ % (1u << 22));
+        const float u1 = fraction(shift_a + index * kR2a), u2 = fraction(shift_b + index * kR2b);
+        const float radius = std::sqrt(u1), phi = 2 * float(M_PI) * u2;
+        const Eigen::Vector3f direction =
+            to_world * Eigen::Vector3f(radius * std::cos(phi), radius * std::sin(phi),
+                                       std::sqrt(std::max(0.0f, 1 - u1)));
+        const float t_max = std::min(params_.indirect_max_distance_m, box.exit(origin, direction));
+        const fusion::MarchEnd hit =
+            fusion::first_surface(sampler, volume, origin, direction, 0.0f, t_max);
+        if (hit.back_face) continue;                         // unknown radiance: not counted
+        Eigen::Vector3f radiance = Eigen::Vector3f::Zero();  // none beyond the reconstruction
+        if (hit.t > 0) {
+          const Eigen::Vector3f h = origin + direction * hit.t;
+          if (!on_light(lights, h, margin) && !hit_radiance(grid, h, direction, blocks, radiance))
+            continue;
+          if (!(radiance.maxCoeff() < params_.saturated_radiance))
+            radiance = Eigen::Vector3f::Zero();
+        }
+        if (indirect_rays_[v] < n) {
+          indirect_sum_[v] += radiance;
+          ++indirect_rays_[v];
+        } else {  // a moving average over the latest n
+          indirect_sum_[v] += radiance - indirect_sum_[v] / float(n);
+        }
+      }
+    }
+  });
+}
+
+PointLighting PointLightingQuery::operator()(const Eigen::Vector3f& p, const Eigen::Vector3f& n) {
+  PointLighting result;
+  const LightTransportParams& params = transport_.params();
+  if (params.shadows)
+    result.lit = shadow_mask(sampler_, volume_, lights_, p, n, params.ray_offset_m);
+  if (params.indirect)
+    if (const int v = grid_.find(p, &blocks_); v >= 0)
+      result.indirect = transport_.lighting(v).indirect;
+  return result;
+}
+
+}  // namespace glint::reflectance
