@@ -13,6 +13,9 @@ packages=(
   libembree-dev libtinyobjloader-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  # OpenCASCADE: CAD-kernel training data and STEP input for BoundED (src/cad).
+  libocct-foundation-dev libocct-modeling-data-dev libocct-modeling-algorithms-dev
+  libocct-data-exchange-dev
 )
 if [[ "${1:-}" == "--peers" ]]; then
   packages+=(libopen3d-dev libpcl-dev libcgal-dev)
