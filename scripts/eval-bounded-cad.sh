@@ -6,7 +6,7 @@
 # training seeds) and bounded-<c>c-old.json (the models shipped before them) are scored beside
 # the baselines `glint edges eval` prints (CA, and the angle-gap boundary criterion where the
 # build has it).
-# Held-out set: 30 parts of seed 9001 (training used seed 101, model selection seed 5001; the
+# Held-out set: 20 parts of seed 9001 (training used seed 101, model selection seed 5001; the
 # recipe `cylinder` was never trained on), each sampled at its mesh vertices and uniformly,
 # clean and with noise 0.25, 0.5 and 1 median spacing along the normal: sharp edges scored on
 # the closed parts, boundaries on the same parts cut open by a random plane.
@@ -36,7 +36,7 @@ for sampling in vertices uniform; do
       cut=0
       [[ $opening == cut ]] && cut=1
       [[ -f "$set_dir/manifest.json" ]] ||
-        "${NICE[@]}" "$GLINT" --quiet edges synth --kind cad -o "$set_dir" --count 30 --seed 9001 \
+        "${NICE[@]}" "$GLINT" --quiet edges synth --kind cad -o "$set_dir" --count 20 --seed 9001 \
           --sampling "$sampling" --noise "$noise" --outliers 0 --plane-cut "$cut" \
           --min-points 4000 --max-points 40000
     done

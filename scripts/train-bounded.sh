@@ -4,7 +4,7 @@
 # Training data (never the evaluation clouds or their twins):
 #   * 600 procedural clouds (glint edges synth, seed 1; the shapes annulus and hemisphere are
 #     held out for the boundary evaluation), noise up to 1 point spacing;
-#   * 400 CAD-kernel clouds (glint edges synth --kind cad, seed 101; the recipe `cylinder` is
+#   * 300 CAD-kernel clouds (glint edges synth --kind cad, seed 101; the recipe `cylinder` is
 #     held out for the evaluation), sampled at mesh vertices, uniformly and scan-like, 20 % cut
 #     open by a plane and 15 % with faces removed, noise up to 1 spacing along the normal;
 #   * bazazian/edge-rule without the default-eval twins (CubeFractal2, every Frac2* noisy
@@ -26,7 +26,7 @@ BAZAZIAN="$DATA/pointclouds/bazazian/edge-rule"
 TWINS=(--exclude CubeFractal2 --exclude Frac2 --exclude TwoPlane90)
 OPEN_SURFACES=(--exclude TwoPlane --exclude Two22plane --exclude IntersectionThreePlanes)
 NOTES="Trained on glint edges synth (seed 1, 600 clouds, shapes annulus and hemisphere held out, \
-noise 0-1 spacing), glint edges synth --kind cad (seed 101, 400 clouds, recipe cylinder held out) \
+noise 0-1 spacing), glint edges synth --kind cad (seed 101, 300 clouds, recipe cylinder held out) \
 and bazazian/edge-rule without the default-eval twins (CubeFractal2, Frac2Guass*/Frac2withNoise*, \
 TwoPlane90)"
 NICE=(nice -n 10)
@@ -36,9 +36,9 @@ mkdir -p "$WORK/models"
   "${NICE[@]}" "$GLINT" edges synth -o "$WORK/synth" --count 600 --seed 1 \
     --exclude-shapes annulus,hemisphere --noise 0,0,0.02,0.05,0.1,0.25,0.5,1
 [[ -f "$WORK/cad/manifest.json" ]] ||
-  "${NICE[@]}" "$GLINT" edges synth --kind cad -o "$WORK/cad" --count 400 --seed 101 \
+  "${NICE[@]}" "$GLINT" edges synth --kind cad -o "$WORK/cad" --count 300 --seed 101 \
     --recipes block,plate,extrusion,turned --plane-cut 0.2 --faces-removed 0.15 \
-    --noise 0,0,0.25,0.5,1 --min-points 4000 --max-points 40000
+    --noise 0,0,0.25,0.5,1 --min-points 3000 --max-points 30000
 
 train() {  # classes seed
   local classes=$1 seed=$2 extra=()
@@ -56,9 +56,9 @@ done
 
 # The CAD validation set of the selection rule (seed 5001: neither trained on nor evaluated).
 [[ -f "$WORK/cad-val/manifest.json" ]] ||
-  "${NICE[@]}" "$GLINT" edges synth --kind cad -o "$WORK/cad-val" --count 60 --seed 5001 \
+  "${NICE[@]}" "$GLINT" edges synth --kind cad -o "$WORK/cad-val" --count 40 --seed 5001 \
     --sampling vertices,uniform --noise 0,0.5,1 --min-points 4000 --max-points 40000
 [[ -f "$WORK/cad-val-cut/manifest.json" ]] ||
-  "${NICE[@]}" "$GLINT" edges synth --kind cad -o "$WORK/cad-val-cut" --count 60 --seed 5001 \
+  "${NICE[@]}" "$GLINT" edges synth --kind cad -o "$WORK/cad-val-cut" --count 40 --seed 5001 \
     --sampling vertices,uniform --noise 0,0.5,1 --plane-cut 1 --min-points 4000 --max-points 40000
 /usr/bin/python3 "$(dirname "$0")/select-bounded.py" "$GLINT" "$WORK" models
