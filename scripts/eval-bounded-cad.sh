@@ -11,12 +11,17 @@
 # clean and with noise 0.25, 0.5 and 1 median spacing along the normal: sharp edges scored on
 # the closed parts, boundaries on the same parts cut open by a random plane.
 set -euo pipefail
+shopt -s nullglob
 GLINT=${1:-build/release/apps/glint/glint}
 DATA=${2:-${GLINT_DATA:-../shared/data}}
 TRAIN=${3:-build/train}
 WORK=${4:-build/eval-cad}
 NICE=(nice -n 10)
-mkdir -p "$WORK"
+mkdir -p "$WORK" "$TRAIN/models"
+for classes in 3 2; do  # the models shipped before the CAD-kernel training, if not kept yet
+  [[ -f "$TRAIN/models/bounded-${classes}c-old.json" ]] ||
+    cp "models/bounded-${classes}c.json" "$TRAIN/models/bounded-${classes}c-old.json"
+done
 
 models() {  # classes
   for m in "$TRAIN/models/bounded-$1c-old.json" "$TRAIN"/models/bounded-"$1"c-s[0-9].json; do

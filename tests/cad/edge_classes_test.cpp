@@ -98,9 +98,12 @@ TEST(EdgeClasses, CutCylinderHasItsBoundaryOnTheCutOnly) {
       ++boundary;
       EXPECT_LE(cloud.z[i], 4.0 + band + 1e-4);
     }
-    if (cloud.z[i] < 4.0 + 0.3 * band) EXPECT_EQ(labels[i], 2);
-    if (cloud.z[i] > 4.0 + band + 1e-3 && cloud.z[i] < 10.0 - band)
+    if (cloud.z[i] < 4.0 + 0.3 * band) {
+      EXPECT_EQ(labels[i], 2);
+    }
+    if (cloud.z[i] > 4.0 + band + 1e-3 && cloud.z[i] < 10.0 - band) {
       EXPECT_EQ(labels[i], 0);  // the side between cut and rim, the seam included
+    }
   }
   EXPECT_GT(boundary, 50);
 }
