@@ -1,10 +1,13 @@
 # Thin wrapper over CMake presets. `make demo` and `make test` set up a fresh Debian 12 machine.
+# `make install PREFIX=DIR` installs there (default /usr/local); `make package` builds the .deb
+# files in build/release (docs/install.md).
 JOBS ?= $(shell nproc)
+PREFIX ?= /usr/local
 BUILD := build/release
 GLINT := $(BUILD)/apps/glint/glint
 DATA ?= $(or $(GLINT_DATA),../shared/data)
 
-.PHONY: deps build demo test bench asan format-check clean
+.PHONY: deps build install package demo test bench asan format-check clean
 
 deps:
 	bash scripts/install-deps.sh
@@ -12,6 +15,12 @@ deps:
 build: deps
 	cmake --preset release
 	cmake --build --preset release -j $(JOBS)
+
+install: build
+	cmake --install $(BUILD) --prefix $(PREFIX)
+
+package: build
+	cmake --build $(BUILD) --target package
 
 demo: build
 	bash scripts/demo.sh $(GLINT) $(DATA)

@@ -15,12 +15,30 @@
 # Every 10th frame (and the last) is scored; about 13 minutes on 2 cores for the three scenes
 # once they are rendered. SCENES may also name "heldout" and "heldout-cubes": bunnies and cubes
 # with materials no training choice was made on (scripts/heldout-scene.py), lit as their bases.
+# VARIANT chooses the light transport the sequences are rendered with (the light captures are
+# direct light with shadows in every variant):
+#   noshadow (default) direct light without shadows, the pipeline's image model (Table 1);
+#   shadow             direct light with shadows;
+#   bounceN            shadows and N bounces of path-traced indirect light (e.g. bounce3).
+# OUT defaults to build/eval-reflectance, or build/eval-reflectance-VARIANT for the others; an
+# OUT that already holds seq-SCENE and capture-SCENE is evaluated without rendering.
 # Reports: OUT/<scene>-<variant>/report.json; a summary table: OUT/summary.md.
-#   scripts/eval-reflectance.sh GLINT DATA [OUT] [SCENES] [FRAMES]
+#   [VARIANT=shadow] scripts/eval-reflectance.sh GLINT DATA [OUT] [SCENES] [FRAMES]
 set -euo pipefail
 GLINT=${1:?usage: eval-reflectance.sh GLINT DATA [OUT] [SCENES] [FRAMES]}
 DATA=${2:?usage: eval-reflectance.sh GLINT DATA [OUT] [SCENES] [FRAMES]}
-OUT=${3:-build/eval-reflectance}
+VARIANT=${VARIANT:-noshadow}
+case $VARIANT in
+  noshadow) LIGHT_TRANSPORT=(--no-shadows) DEFAULT_OUT=build/eval-reflectance ;;
+  shadow) LIGHT_TRANSPORT=() DEFAULT_OUT=build/eval-reflectance-shadow ;;
+  bounce[1-9] | bounce[1-9][0-9])
+    LIGHT_TRANSPORT=(--bounces "${VARIANT#bounce}") DEFAULT_OUT=build/eval-reflectance-$VARIANT ;;
+  *)
+    echo "eval-reflectance.sh: VARIANT must be noshadow, shadow or bounceN, not '$VARIANT'" >&2
+    exit 2
+    ;;
+esac
+OUT=${3:-$DEFAULT_OUT}
 SCENES=${4:-bunnies cubes office}
 FRAMES=${5:-300}
 MODELS=$(dirname "$0")/../models
@@ -34,12 +52,12 @@ render_scene() {  # render_scene SCENE: OUT/seq-SCENE and OUT/capture-SCENE
     render_scene "$base"
     python3 "$(dirname "$0")/heldout-scene.py" "$scene" "$OUT/seq-$base/scene.json" \
       "$OUT/$scene.json"
-    "$GLINT" --quiet render "$OUT/$scene.json" -o "$seq" --no-shadows
+    "$GLINT" --quiet render "$OUT/$scene.json" -o "$seq" "${LIGHT_TRANSPORT[@]}"
     ln -sfn "capture-$base" "$cap"
     return 0
   fi
-  [[ -d "$seq" ]] || "$GLINT" --quiet synth "$scene" -o "$seq" --frames "$FRAMES" --no-shadows \
-    --data "$DATA"
+  [[ -d "$seq" ]] || "$GLINT" --quiet synth "$scene" -o "$seq" --frames "$FRAMES" \
+    "${LIGHT_TRANSPORT[@]}" --data "$DATA"
   [[ -d "$cap" ]] || "$GLINT" --quiet synth lights --scene "$scene" -o "$cap" --frames 60 \
     --data "$DATA"
 }

@@ -2,11 +2,11 @@
 """Held-out scenes for the reflectance evaluation: a built-in scene's geometry, lights and camera
 path with materials no training choice was made on.
   heldout        bunnies with a blue-grey floor, a glossy dark-green bunny, a white one and a
-                 copper one (a metal's tinted highlight); made 2026-11-29 (docs/reflectance/
-                 history.md, eighth session).
+                 copper one (a metal's tinted highlight); made before the training materials'
+                 colours were changed.
   heldout-cubes  cubes with a warm light-grey floor and light-grey, purple, pale-pink, dark-grey,
                  olive and silver cubes: matte near-greys, which the training materials drew
-                 rarely; made 2026-12-01 before any network was trained on the near-grey set.
+                 rarely; made before any network was trained on the near-grey set.
 `heldout-scene.py base NAME` prints NAME's base scene. Otherwise reads the scene.json of the
 rendered base sequence and writes the edited copy; then
   glint render OUT.json -o seq-heldout --no-shadows

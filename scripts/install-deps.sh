@@ -16,6 +16,8 @@ packages=(
   # OpenCASCADE: CAD-kernel training data and STEP input for BoundED (src/cad).
   libocct-foundation-dev libocct-modeling-data-dev libocct-modeling-algorithms-dev
   libocct-data-exchange-dev
+  # make package: CPack's .deb finds its shared-library dependencies with dpkg-shlibdeps and file.
+  dpkg-dev file
 )
 if [[ "${1:-}" == "--peers" ]]; then
   packages+=(libopen3d-dev libpcl-dev libcgal-dev)

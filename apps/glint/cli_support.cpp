@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/resources.h"
 
 namespace glint::app {
 namespace {
@@ -76,12 +77,7 @@ std::vector<std::string> expand_point_cloud_inputs(const std::vector<std::string
   return files;
 }
 
-std::string models_directory() {
-  if (const char* env = std::getenv("GLINT_MODELS")) return env;
-  return GLINT_SOURCE_MODELS_DIR;
-}
-
-std::string default_edges_model() { return models_directory() + "/bounded-3c.json"; }
+std::string default_edges_model() { return model_path("bounded-3c.json").string(); }
 
 namespace {
 std::string recorded_command_line;

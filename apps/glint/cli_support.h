@@ -10,9 +10,8 @@ namespace glint::app {
 // list of point-cloud files. A path that does not exist -> glint::Error naming it.
 std::vector<std::string> expand_point_cloud_inputs(const std::vector<std::string>& paths);
 
-// Where shipped models live: $GLINT_MODELS, else the source tree's models/ folder.
-std::string models_directory();
-// The shipped 3-class BoundED model, the default of classify and eval.
+// The shipped 3-class BoundED model, the default of classify and eval (core/resources.h finds
+// the models folder).
 std::string default_edges_model();
 
 // Option checks for numbers > 0 and >= 0, shown as POSITIVE and NONNEGATIVE in --help like

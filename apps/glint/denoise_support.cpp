@@ -8,7 +8,6 @@
 #include "core/error.h"
 #include "core/progress.h"
 #include "denoise/denoise_plugin.h"
-#include "plugin_loader.h"
 
 namespace glint::app {
 
@@ -121,7 +120,7 @@ DenoiseRun run_denoiser(const std::string& method, const DenoiserOptions& option
   params.snapshot = snapshot;
   params.snapshot_every = snapshot_every;
   const auto entry = reinterpret_cast<denoise::DenoisePluginEntry>(
-      plugin_entry("GLINT_DENOISE_PLUGIN", GLINT_DENOISE_PLUGIN, denoise::kDenoisePluginEntry));
+      plugin_entry(denoise::kDenoisePlugin, denoise::kDenoisePluginEntry));
   denoise::DenoisePluginCall call;
   call.noisy = &noisy;
   call.guidance = guidance;

@@ -1,5 +1,6 @@
-// glint edges eval: thesis §5.5.2 scores of glint models, saved predictions and the
-// covariance-analysis baseline on labelled clouds, per file with median and mean.
+// glint edges eval: thesis §5.5.2 scores of glint models, saved predictions, the
+// covariance-analysis baseline and the angle-gap boundary baseline on labelled clouds, per file
+// with median and mean.
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -10,6 +11,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/timer.h"
+#include "edges/angle_gap_baseline.h"
 #include "edges/classifier.h"
 #include "edges/covariance_baseline.h"
 #include "edges/metrics.h"
@@ -25,6 +27,7 @@ struct EvalOptions {
   std::vector<std::string> predictions;
   std::string task = "sharp";
   edges::CovarianceBaselineParams baseline;
+  edges::AngleGapParams angle_gap;
   bool no_baseline = false;
   std::string report;
 };
@@ -77,6 +80,9 @@ void run_eval(EvalOptions options) {
   for (const auto& [name, model] : models) methods.push_back(name);
   if (!options.predictions.empty()) methods.push_back("predictions");
   if (!options.no_baseline) methods.push_back("CA");
+  // The angle-gap criterion finds boundaries only: no column for the sharp task.
+  const bool run_angle_gap = !options.no_baseline && task != edges::EvalTask::sharp;
+  if (run_angle_gap) methods.push_back("angle-gap");
   std::map<std::string, std::vector<edges::BinaryScores>> per_method;
   nlohmann::json files_json = nlohmann::json::array();
 
@@ -125,6 +131,11 @@ void run_eval(EvalOptions options) {
         const auto labels = edges::classify_covariance_baseline(cloud, options.baseline);
         record("CA", labels, watch.elapsed_s());
       }
+      if (run_angle_gap) {
+        Stopwatch watch;
+        const auto labels = edges::classify_angle_gap(cloud, options.angle_gap);
+        record("angle-gap", labels, watch.elapsed_s());
+      }
     } catch (const Error& e) {
       throw Error(e.file().empty() ? path : e.file(), e.element(), e.reason());
     }
@@ -151,6 +162,15 @@ void run_eval(EvalOptions options) {
                                       {"k", options.baseline.k},
                                       {"threshold", options.baseline.threshold},
                                       {"enabled", !options.no_baseline}}},
+                                    {"angle_gap_baseline",
+                                     {{"method",
+                                       "largest angular gap of the radius neighbours around the "
+                                       "PCA normal (PCL BoundaryEstimation / Open3D rule)"},
+                                      {"k", options.angle_gap.k},
+                                      {"radius_spacings", options.angle_gap.radius_spacings},
+                                      {"radius", options.angle_gap.radius},
+                                      {"angle_threshold_rad", options.angle_gap.angle_threshold},
+                                      {"enabled", run_angle_gap}}},
                                     {"files", files_json},
                                     {"summary", summary_json}});
     fmt::print("report -> {}\n", options.report);
@@ -167,7 +187,10 @@ void register_edges_eval(CLI::App& edges) {
       "Precision, Recall, MCC, F1, Accuracy, IoU per file, then median and mean.\n"
       "Methods: each --model (classified here), --pred files (e.g. from 'edges classify'\n"
       "or another tool; read from label/scalar_label), and the covariance-analysis baseline\n"
-      "CA (surface variation > threshold), printed beside glint unless --no-baseline.\n"
+      "CA (surface variation > threshold), printed beside glint unless --no-baseline,\n"
+      "and for --task boundary or edge the angle-gap boundary baseline (PCL's\n"
+      "BoundaryEstimation rule on PCA normals: boundary where the neighbours within\n"
+      "--ag-radius-spacings local spacings leave an angular gap > --ag-threshold).\n"
       "With neither --model nor --pred the shipped 3-class model is evaluated.\n"
       "Example: glint edges eval ../shared/data/pointclouds/default-eval \\\n"
       "           --model models/bounded-3c.json --model models/bounded-2c.json");
@@ -190,7 +213,25 @@ void register_edges_eval(CLI::App& edges) {
       ->add_option("--ca-threshold", options->baseline.threshold,
                    "CA surface-variation threshold (0.025: thesis, tuned on Default)")
       ->capture_default_str();
-  command->add_flag("--no-baseline", options->no_baseline, "Skip the CA baseline");
+  command
+      ->add_option("--ag-k", options->angle_gap.k,
+                   "Angle-gap: neighbours for the PCA normal and the local spacing")
+      ->capture_default_str();
+  command
+      ->add_option("--ag-radius-spacings", options->angle_gap.radius_spacings,
+                   "Angle-gap: search radius in local point spacings (spacing = k-th neighbour "
+                   "distance x sqrt(pi/k))")
+      ->capture_default_str();
+  command
+      ->add_option("--ag-radius", options->angle_gap.radius,
+                   "Angle-gap: fixed search radius in cloud units instead (0 = adaptive)")
+      ->capture_default_str();
+  command
+      ->add_option("--ag-threshold", options->angle_gap.angle_threshold,
+                   "Angle-gap: boundary when the largest gap exceeds this, radians (pi/2: the "
+                   "PCL and Open3D default)")
+      ->capture_default_str();
+  command->add_flag("--no-baseline", options->no_baseline, "Skip the CA and angle-gap baselines");
   command->add_option("--report", options->report, "Write all scores as JSON")->check(kOutputFile);
   command->callback([options] { run_eval(*options); });
 }

@@ -15,7 +15,6 @@
 #include "edges/train_plugin.h"
 #include "io/json_report.h"
 #include "io/point_cloud_io.h"
-#include "plugin_loader.h"
 
 namespace glint::app {
 namespace {
@@ -30,12 +29,11 @@ struct TrainOptions {
   edges::TrainParams params;
 };
 
-// Trains in the plugin module (see edges/train_plugin.h): $GLINT_TRAIN_PLUGIN, else the one
-// built beside this executable.
+// Trains in the plugin module (see edges/train_plugin.h), found by core/resources.h.
 edges::Model train_in_plugin(const edges::TrainingSet& set, const edges::ModelConfig& config,
                              const edges::TrainParams& params) {
   const auto entry = reinterpret_cast<edges::TrainPluginEntry>(
-      plugin_entry("GLINT_TRAIN_PLUGIN", GLINT_TRAIN_PLUGIN, edges::kTrainPluginEntry));
+      plugin_entry(edges::kTrainPlugin, edges::kTrainPluginEntry));
   edges::Model model;
   edges::TrainPluginCall call;
   call.data = &set;

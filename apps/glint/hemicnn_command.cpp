@@ -15,7 +15,6 @@
 #include "core/progress.h"
 #include "core/timer.h"
 #include "io/json_report.h"
-#include "plugin_loader.h"
 #include "reflectance/hemi_dataset.h"
 #include "reflectance/hemicnn.h"
 #include "reflectance/hemicnn_train_plugin.h"
@@ -40,13 +39,13 @@ struct PredictOptions {
   std::uint64_t seed = 1;
 };
 
-// Trains in the plugin module (see reflectance/hemicnn_train_plugin.h): $GLINT_HEMICNN_PLUGIN,
-// else the one built beside this executable.
+// Trains in the plugin module (see reflectance/hemicnn_train_plugin.h), found by
+// core/resources.h.
 reflectance::HemiCnn train_in_plugin(const reflectance::HemiDataset& data,
                                      const reflectance::HemiCnnConfig& config,
                                      const reflectance::HemiCnnTrainParams& params) {
   const auto entry = reinterpret_cast<reflectance::HemiCnnPluginEntry>(
-      plugin_entry("GLINT_HEMICNN_PLUGIN", GLINT_HEMICNN_PLUGIN, reflectance::kHemiCnnPluginEntry));
+      plugin_entry(reflectance::kHemiCnnPlugin, reflectance::kHemiCnnPluginEntry));
   reflectance::HemiCnn model;
   reflectance::HemiCnnPluginCall call;
   call.data = &data;

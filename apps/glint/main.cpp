@@ -8,6 +8,7 @@
 
 #include "cli_support.h"
 #include "commands.h"
+#include "core/build_info.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/parallel.h"
@@ -29,9 +30,13 @@ int main(int argc, char** argv) {
       "Online reflectance reconstruction from RGB-D (fuse, lights, reconstruct, hemicnn;\n"
       "render and synth make synthetic sequences with ground truth), locally-guided image\n"
       "denoising (denoise) and point-cloud edge/boundary detection (edges, BoundED).\n"
-      "Run 'glint <command> --help' for the options of each command."};
+      "Run 'glint <command> --help' for the options of each command. The options below\n"
+      "(--quiet, --threads, --log-level) go before or after the command:\n"
+      "'glint --quiet edges classify a.ply -o b.ply' = 'glint edges classify a.ply -o b.ply -q'."};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "glint 0.1.0");
+  app.set_version_flag(
+      "--version", [] { return glint::describe_build(); },
+      "The version, the optional parts compiled in, where models and plugins are");
 
   glint::app::remember_command_line(argc, argv);
   glint::app::CommonOptions common;
@@ -39,6 +44,9 @@ int main(int argc, char** argv) {
   app.add_option("--threads", common.threads, "Worker threads (0 = all cores)")
       ->check(glint::app::kNonNegative);
   app.add_option("--log-level", common.log_level, "trace, debug, info, warn, error, off");
+  // Options a command does not know pass up to its parent, so the global ones above are taken
+  // after the command too. Commands inherit this when they are added, so it comes first.
+  app.fallthrough();
 
   glint::app::register_edges_commands(app);
   glint::app::register_denoise_commands(app);

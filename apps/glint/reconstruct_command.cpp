@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/progress.h"
+#include "core/resources.h"
 #include "core/timer.h"
 #include "fusion/depth_maps.h"
 #include "fusion/marching_cubes.h"
@@ -92,7 +93,7 @@ struct ReconstructOptions {
   std::string views;     // TUM trajectory of extra poses to re-render at the end
   // The ray-cast normals of renderings are smoothed within this radius: the TSDF's surface
   // carries millimetre bumps from the depth quantisation that its per-pixel normals turn into
-  // speckled shading (4 voxels at 5 mm; chosen on cubes, see docs/reflectance/history.md).
+  // speckled shading (4 voxels at 5 mm; docs/decisions.md).
   float render_normal_radius_m = 0.02f;
   reflectance::ReflectanceParams params;
 };
@@ -159,9 +160,8 @@ void run_reconstruct(ReconstructOptions options) {
   const std::vector<io::StampedPose> views = options.views.empty()
                                                  ? std::vector<io::StampedPose>{}
                                                  : io::read_tum_trajectory(options.views);
-  const std::string model_path = options.model.empty()
-                                     ? (fs::path(models_directory()) / "hemicnn.json").string()
-                                     : options.model;
+  const std::string model_path =
+      options.model.empty() ? glint::model_path("hemicnn.json").string() : options.model;
   const reflectance::HemiCnn network = reflectance::HemiCnn::load(model_path);
 
   // Everything goes to a temporary folder renamed onto OUT at the end: a failure leaves no

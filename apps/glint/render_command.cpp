@@ -1,5 +1,5 @@
 // glint render: a scene.json rendered along its trajectory into an RGB-D sequence with ground
-// truth (README "Rendering (glint render)").
+// truth (docs/reflectance.md, "render").
 #include <fmt/format.h>
 
 #include <cmath>
@@ -23,6 +23,7 @@ struct RenderOptions {
   std::optional<int> width, height;
   std::optional<float> exposure;
   bool no_shadows = false;
+  std::optional<int> bounces, indirect_samples;
 };
 
 void run_render(const RenderOptions& options) {
@@ -36,6 +37,8 @@ void run_render(const RenderOptions& options) {
   }
   if (options.exposure) scene.camera.exposure = *options.exposure;
   if (options.no_shadows) scene.shadows = false;
+  if (options.bounces) scene.bounces = *options.bounces;
+  if (options.indirect_samples) scene.indirect_samples = *options.indirect_samples;
   const render::SequenceStats stats =
       render::write_sequence(scene, options.output, options.sequence);
   log().info("{}: {} frames {}x{} -> {} in {:.1f} s (median {:.1f} ms render, {:.1f} ms per frame)",
@@ -49,6 +52,8 @@ void run_render(const RenderOptions& options) {
                                     {"first_frame", options.sequence.first_frame},
                                     {"frames", stats.frames},
                                     {"shadows", scene.shadows},
+                                    {"bounces", scene.bounces},
+                                    {"indirect_samples", scene.indirect_samples},
                                     {"objects", scene.objects.size()},
                                     {"lights", scene.lights.size()},
                                     {"environment", scene.environment.has_value()},
@@ -67,7 +72,8 @@ void register_render_command(CLI::App& app) {
       "environment, camera and trajectory) into an RGB-D sequence: rgb/ (8-bit sRGB, exposed\n"
       "and clipped), depth/ (16-bit mm), associations.txt, groundtruth.txt (TUM),\n"
       "intrinsics.json, gt/ (depth, normal, segment, kd, ks, alpha) and scene.json.\n"
-      "Direct lighting only (no interreflections); see README 'Rendering (glint render)'.");
+      "Direct light by default; --bounces N adds N bounces of path-traced indirect light\n"
+      "(docs/reflectance.md, 'render').");
   command->add_option("scene", options->scene_path, "Scene description (scene.json)")
       ->required()
       ->check(CLI::ExistingFile);
@@ -87,6 +93,16 @@ void register_render_command(CLI::App& app) {
   command->add_option("--exposure", options->exposure, "Override the camera exposure")
       ->check(kPositive);
   command->add_flag("--no-shadows", options->no_shadows, "Skip shadow rays");
+  command
+      ->add_option("--bounces", options->bounces,
+                   "Indirect bounces to path trace (overrides scene.json's \"bounces\", default "
+                   "0 = direct light only, the reflectance pipeline's image model)")
+      ->check(kNonNegative);
+  command
+      ->add_option("--indirect-samples", options->indirect_samples,
+                   "Paths per pixel for the indirect light (overrides scene.json, default 32); "
+                   "its noise falls as 1/sqrt(samples), time grows linearly")
+      ->check(kPositive);
   command->add_flag(
       "--no-gt", [options](std::int64_t) { options->sequence.ground_truth = false; },
       "Do not write gt/");
@@ -95,7 +111,8 @@ void register_render_command(CLI::App& app) {
       "Examples:\n"
       "  glint render scene.json -o seq\n"
       "  glint render scene.json -o preview --frames 10 --width 256 --no-gt\n"
-      "  glint render scene.json -o capture --exposure 0.01 --report capture.json");
+      "  glint render scene.json -o capture --exposure 0.01 --report capture.json\n"
+      "  glint render scene.json -o bounced --bounces 3 --indirect-samples 64");
   command->callback([options] { run_render(*options); });
 }
 

@@ -32,6 +32,8 @@ struct SynthCommandOptions {
   float near_grey_share = render::MaterialRanges{}.near_grey_share;
   bool no_ground_truth = false;
   bool no_shadows = false;
+  int bounces = 0;
+  int indirect_samples = render::Scene{}.indirect_samples;
   bool preview = false;
   std::string report;
 };
@@ -92,12 +94,16 @@ nlohmann::json run_scene(const SynthCommandOptions& options) {
     scene = render::make_light_capture(scene, path);
   }
   scene.shadows = !options.no_shadows;
+  scene.bounces = options.bounces;
+  scene.indirect_samples = options.indirect_samples;
   nlohmann::json report{{"scene", options.what},
                         {"frames", scene.trajectory.size()},
                         {"width", builtin.width},
                         {"height", builtin.height},
                         {"seed", options.seed},
                         {"shadows", scene.shadows},
+                        {"bounces", scene.bounces},
+                        {"indirect_samples", scene.indirect_samples},
                         {"exposure", scene.camera.exposure}};
   if (light_capture) report["captured_scene"] = options.capture_scene;
   if (options.preview) {
@@ -179,6 +185,17 @@ void register_synth_command(CLI::App& app) {
       ->capture_default_str();
   command->add_flag("--no-gt", options->no_ground_truth, "Do not write the gt/ maps");
   command->add_flag("--no-shadows", options->no_shadows, "Scenes: no shadow rays");
+  command
+      ->add_option("--bounces", options->bounces,
+                   "Scenes: indirect bounces to path trace (0 = direct light only, the "
+                   "pipeline's image model; the training set is always direct)")
+      ->check(kNonNegative)
+      ->capture_default_str();
+  command
+      ->add_option("--indirect-samples", options->indirect_samples,
+                   "Scenes: paths per pixel for the indirect light (noise ~ 1/sqrt(samples))")
+      ->check(kPositive)
+      ->capture_default_str();
   command->add_flag("--preview", options->preview,
                     "Only frame 0 as PNGs for people: rgb, depth (false colour), kd, ks, alpha");
   command->add_option("--report", options->report, "JSON report with parameters and timings")
@@ -192,6 +209,7 @@ void register_synth_command(CLI::App& app) {
       "Examples:\n"
       "  glint synth bunnies -o seq/bunnies --frames 1000\n"
       "  glint synth lights --scene bunnies -o seq/bunnies-lights\n"
+      "  glint synth office -o seq/office-bounce3 --bounces 3\n"
       "  glint synth office -o pictures/office --preview\n"
       "  glint synth training -o train --sequences 400 --report train.json");
   command->callback([options] { run_synth(*options); });

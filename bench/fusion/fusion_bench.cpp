@@ -1,5 +1,5 @@
 // glint fusion vs Open3D's tensor VoxelBlockGrid on the CPU, on the same frames and
-// ground-truth poses (issue 6, "must show" 1 and 3), and glint's per-stage speed with tracking:
+// ground-truth poses, and glint's per-stage speed with tracking:
 //  - per voxel size: per-frame integration ms (median, mean, p90) of both, their ratio, the
 //    median point-to-surface distance between the two meshes both ways (metres and voxels);
 //  - glint with ICP tracking: per-frame track / raycast / integrate ms, ATE against the ground

@@ -10,6 +10,7 @@
 #include <random>
 #include <vector>
 
+#include "core/resources.h"
 #include "reflectance/albedo_refinement.h"
 #include "reflectance/depth_segmentation.h"
 #include "reflectance/hemi_image.h"
@@ -36,7 +37,7 @@ std::vector<Observation> random_observations(int count, std::uint64_t seed) {
 }
 
 HemiCnn shipped_or_default_model() {
-  const std::string path = std::string(GLINT_SOURCE_MODELS_DIR) + "/hemicnn.json";
+  const std::filesystem::path path = models_directory() / "hemicnn.json";
   return std::filesystem::exists(path) ? HemiCnn::load(path) : HemiCnn();
 }
 

@@ -1,4 +1,4 @@
-// Speed of the synthetic-data renderer (issue 5, "must show" 3): frames per second of the
+// Speed of the synthetic-data renderer: frames per second of the
 // built-in `bunnies` scene at 512x424 with and without shadow rays, and the time to generate
 // the default training set, measured on its first --training-sequences sequences and
 // extrapolated linearly (every sequence is drawn from the same distribution).

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The neural denoisers' full configuration on a GPU machine that has PyTorch (CUDA) but none of
-# glint's Debian packages (OpenCV, Embree, ...), as the device machines lent to some sessions:
+# glint's Debian packages (OpenCV, Embree, ...), a lent device machine for example:
 # builds glint's neural denoisers (src/denoise, the code `glint denoise run` loads as its
 # plugin) against PyTorch's libtorch with a small driver (driver.cpp), runs DIP and guided DIP
 # (3,000 steps) on each protocol image and S2S / guided S2S for a timing (1,000 of the 150,000

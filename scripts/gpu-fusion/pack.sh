@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Gathers what the CUDA integration checks need on a GPU machine that has a CUDA driver but none
-# of glint's Debian packages (as the device machines lent to some sessions): the CUDA
+# of glint's Debian packages (a lent device machine, for example): the CUDA
 # integrator's tests and the fusion kernel benchmark from a GLINT_WITH_CUDA build, and the
 # shared libraries they load beyond the C and C++ runtimes (for run.sh). Given a list of the
 # sonames the GPU machine lacks (ldconfig -p there), also glint itself with those of its

@@ -1,10 +1,11 @@
 #pragma once
-// The neural denoisers as a loadable module (libglint_denoise_plugin.so): libtorch costs about
+// The neural denoisers as a loadable module (lib/glint/denoise-nets.so): libtorch costs about
 // 0.4 s of process start-up, so only `glint denoise run|eval` with a neural method opens it.
 // Tests link glint_denoise_nets directly.
 #include <string>
 
 #include "core/plugin_call.h"
+#include "core/resources.h"
 #include "denoise/neural.h"
 
 namespace glint::denoise {
@@ -22,5 +23,6 @@ struct DenoisePluginCall {
 // extern "C" entry point of the module: 0 on success, 1 on failure.
 using DenoisePluginEntry = int (*)(DenoisePluginCall*);
 inline constexpr const char* kDenoisePluginEntry = "glint_denoise_plugin_entry";
+inline constexpr PluginName kDenoisePlugin{"denoise-nets.so", "GLINT_DENOISE_PLUGIN"};
 
 }  // namespace glint::denoise

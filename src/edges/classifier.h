@@ -25,7 +25,7 @@ Classification classify(const PointCloud& cloud, const Model& model,
 // with the same scales can share one feature matrix); features_s stays 0.
 Classification classify_features(const FeatureMatrix& features, const Model& model);
 
-// Adds the DESIGN.md output attributes: uchar scalar_label, float scalar_p_sharp,
+// Adds the output attributes of docs/edges.md: uchar scalar_label, float scalar_p_sharp,
 // float scalar_p_boundary, and uchar red/green/blue (red = sharp, green = boundary, grey = rest).
 void attach_classification(PointCloud& cloud, const Classification& result);
 

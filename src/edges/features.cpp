@@ -66,22 +66,24 @@ Moments moments_nearest_to(const geometry::Neighbourhood& nb, int k, const Vecto
   scratch.bucket_of.resize(k);
   float* d2 = scratch.squared_distances.data();
   const float cx = float(centre.x()), cy = float(centre.y()), cz = float(centre.z());
-  float largest = 0;
+  // The largest squared distance as the maximum of its bit patterns (the same order for
+  // non-negative floats): an integer maximum, which vectorises where a float one may not.
+  std::int32_t largest_bits = 0;
   for (int j = 0; j < k; ++j) {
     const float ex = nb.dx[j] - cx, ey = nb.dy[j] - cy, ez = nb.dz[j] - cz;
     d2[j] = ex * ex + ey * ey + ez * ez;
-    largest = std::max(largest, d2[j]);
+    largest_bits = std::max(largest_bits, std::bit_cast<std::int32_t>(d2[j]));
   }
+  const float largest = std::bit_cast<float>(largest_bits);
   const float to_bucket = largest > 0 ? float(buckets) / largest : 0.f;
+  std::uint8_t* bucket_of = scratch.bucket_of.data();
+  for (int j = 0; j < k; ++j)
+    bucket_of[j] = std::uint8_t(std::min(int(d2[j] * to_bucket), buckets - 1));
   std::array<int, buckets + 1> histogram{};
-  for (int j = 0; j < k; ++j) {
-    scratch.bucket_of[j] = std::uint8_t(std::min(int(d2[j] * to_bucket), buckets - 1));
-    ++histogram[scratch.bucket_of[j]];
-  }
+  for (int j = 0; j < k; ++j) ++histogram[bucket_of[j]];
   int cut = 0, below = 0;
   while (below + histogram[cut] < count) below += histogram[cut++];
 
-  const std::uint8_t* bucket_of = scratch.bucket_of.data();
   Moments nearest = sum_moments(nb, 0, k, [&](int j) { return bucket_of[j] < cut ? 1.f : 0.f; });
   scratch.straddling.clear();
   for (int j = 0; j < k; ++j) {

@@ -1,11 +1,12 @@
 #pragma once
 // The training plugin's interface. libtorch costs about 0.4 s of process start-up, so only
 // `glint edges train` loads it: train_model() is built into a loadable module
-// (libglint_train_plugin.so) that the executable opens with dlopen. Tests link the training
+// (lib/glint/edges-train.so) that the executable opens with dlopen. Tests link the training
 // code directly (glint_edges_train).
 #include <string>
 
 #include "core/plugin_call.h"
+#include "core/resources.h"
 #include "edges/train.h"
 
 namespace glint::edges {
@@ -22,5 +23,6 @@ struct TrainPluginCall {
 // extern "C" entry point of the module: 0 on success, 1 on failure.
 using TrainPluginEntry = int (*)(TrainPluginCall*);
 inline constexpr const char* kTrainPluginEntry = "glint_train_plugin_entry";
+inline constexpr PluginName kTrainPlugin{"edges-train.so", "GLINT_TRAIN_PLUGIN"};
 
 }  // namespace glint::edges

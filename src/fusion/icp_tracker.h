@@ -16,13 +16,12 @@
 namespace glint::fusion {
 
 struct TrackingParams {
-  // Iterations per pyramid level, finest level first (KinectFusion: 10, 5, 4; on 7-Scenes
-  // 5, 4, 4 gave the same ATE, 7.5 mm at 1 cm voxels, in half the time).
+  // Iterations per pyramid level, finest level first (KinectFusion: 10, 5, 4; these reach the
+  // same ATE on 7-Scenes in half the time).
   std::array<int, 3> iterations{5, 4, 4};
   // A level stops iterating once an update moves the pose by less than this (the norm of the
   // twist: radians and metres; 1e-4 is 0.1 mm, or 0.3 mm at 3 m by rotation, under the depth
-  // noise). 7-Scenes kitchen: tracking 13.6 -> 10.3 ms per frame against 1e-6, ATE 7.151 ->
-  // 7.152 mm; the synthetic scenes' ATE within 1 %.
+  // noise).
   double converged_twist = 1e-4;
   double max_distance_m = 0.10;
   double max_normal_angle_deg = 30;

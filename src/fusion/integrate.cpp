@@ -156,8 +156,7 @@ template <auto depth_at>
     Floats row_first[3];
     for (int axis = 0; axis < 3; ++axis)
       row_first[axis] = (origin[axis] + k.step_z[axis] * float(z)) + kLanes * k.step_y[axis];
-    // Two rows at a time (`IntegrateBlocks` on a Zen 3: 8.6-8.9 -> 7.8-8.1 ms); four ran out of
-    // vector registers and were slower than one (8.9-9.4 ms).
+    // Two rows at a time fill the vector units; four run out of vector registers.
     constexpr int kRows = 2;
     for (int y = 0; y < kBlockSide; y += kRows) {
       float first[kRows][3];

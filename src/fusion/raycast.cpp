@@ -21,9 +21,8 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr int kTilePx = 4;
 
 // Per 4x4-pixel tile, the camera-depth interval that allocated blocks cover (the union of their
-// projected bounding boxes), so rays skip the empty space in front of and behind the model.
-// (8x8 tiles let rays start further in front: office's ray cast took 94 ms per view, 88 with
-// 4x4.)
+// projected bounding boxes), so rays skip the empty space in front of and behind the model
+// (smaller tiles than 8x8 let rays start nearer the surface).
 // Depths are positive floats kept as their bit patterns, which order like the values.
 class TileDepthRanges {
  public:
@@ -269,9 +268,8 @@ constexpr int kRaysInFlight = 4;
 
 // Casts row y's rays into `view` (its colour only where the view has colour), kRaysInFlight at a
 // time. Also compiled for x86-64-v3 (one-instruction rounding, fused multiply-adds, so the last
-// bits of a hit differ from the baseline build's). Cubes re-rendered from poses without a depth
-// hint: 46 ms per view one ray at a time, 40 interleaved, 34 interleaved in the x86-64-v3 clone
-// (which alone gained nothing).
+// bits of a hit differ from the baseline build's). Interleaved rays overlap their chains of
+// dependent loads; the clone pays only with them.
 __attribute__((target_clones("arch=x86-64-v3", "default"), flatten)) void cast_row(
     int y, const TsdfVolume& volume, const BlockOccupancy& occupancy, const TileDepthRanges& ranges,
     const Intrinsics& intrinsics, const Eigen::Matrix3f& rotation, const Eigen::Vector3f& origin,

@@ -24,8 +24,8 @@ namespace {
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 // Cells per typical k-th neighbour distance. A query's candidates are the block of
 // (2·kBlockRadius + 1)³ cells around its cell; finer cells fit that block closer to the
-// neighbourhood's ball (fewer candidates) at the price of more cell look-ups. 2 measured best
-// (1M points, k = 128: 1.28 s vs 1.59 s for 1 and 1.47 s for 3).
+// neighbourhood's ball (fewer candidates) at the price of more cell look-ups; 2 is the
+// fastest on large clouds (docs/decisions.md).
 constexpr int kBlockRadius = 2;
 // Queries whose k-th neighbour lies outside their block retry on a block of this radius.
 constexpr int kRetryBlockRadius = 2 * kBlockRadius;
@@ -199,7 +199,7 @@ struct Scratch {
   std::vector<float> distances;       // squared distance of each candidate to the query
   std::vector<std::uint64_t> ranked;  // (squared distance bits << 32) | candidate
   float previous_kth = 0;             // k-th squared distance of the previous query
-  static constexpr int kBuckets = 256;
+  static constexpr int kBuckets = 128;
   std::vector<std::uint32_t> within;     // candidates inside the bucket range
   std::vector<std::uint16_t> bucket_of;  // bucket of each of them
   std::array<std::uint32_t, kBuckets> bucket_start{};

@@ -126,8 +126,7 @@ void ObservationGrid::prefetch_voxel_state(int block) const {
   prefetch_lines(observation_set_.get() + first, voxels * sizeof(std::int32_t));
   // At 1 cm about 8 of a block's 64 voxels have a surface, and only they are projected and
   // observed: their points, normals and newest directions are asked for instead of the block's
-  // 40 lines of them (cubes and office at 1 cm: 0.4-0.8 ms less per frame). The surface flags
-  // were asked for a block earlier (prefetch_surface_flags).
+  // 40 lines of them. The surface flags were asked for a block earlier (prefetch_surface_flags).
   if (voxels_per_block_ == 64) {
     std::uint64_t surface = 0;
     for (int word = 0; word < 8; ++word)
@@ -152,13 +151,10 @@ void ObservationGrid::geometry_reads_due(int block, int frame, float inverse_geo
                                          GeometryReads& reads) const {
   // A refresh first reads the 4^3 TSDF voxels from floor(p) - 1 on around its start p, the
   // surface point or (without one) the voxel centre (TsdfSampler::trilinear_with_gradient). Only
-  // the lines of the box that holds those stencils are asked for: the whole 2 KB of the block
-  // under the observation block and of the up to seven its stencils might reach was 8 x 32
-  // lines where a refresh or two reads a few dozen, and those prefetches stalled on the full
-  // line-fill buffers (perf, cubes at 2 cm: half of the visibility pass's samples). (Each
-  // stencil's own lines instead of their box: as fast at 2 cm, slower at 1 cm, where a block
-  // has more refreshes due and most of the box is read anyway.) A second Newton step from a
-  // voxel centre reads around its landing point, unprefetched.
+  // the lines of the box that holds those stencils are asked for: the whole blocks the stencils
+  // might reach are 8 x 32 lines where a refresh or two reads a few dozen, and so many
+  // prefetches stall on the full line-fill buffers. A second Newton step from a voxel centre
+  // reads around its landing point, unprefetched.
   reads.count = 0;
   const int first = block * voxels_per_block_;
   const Eigen::Vector3i first_voxel = hash_.block(block) * side_;
@@ -368,8 +364,7 @@ void ObservationGrid::refresh_surface(int v, const Eigen::Vector3f& centre, int 
   const int misses =
       found ? 0 : std::min(surface_misses_[v] + 1, params_.surface_retry_doublings + 1);
   // A settled surface changes little between refreshes: re-reading the TSDF and refitting its
-  // plane every few frames is wasted (bunnies and office at 2 cm: 1.6-2.8 of the stage's 14-22
-  // ms per frame).
+  // plane every few frames is wasted.
   const bool settled =
       found && refine &&
       (p - position_[v]).norm() < float(params_.settled_shift * params_.voxel_size_m);
@@ -468,9 +463,8 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
   const float* depth = depth_m.plane(0);
 
   // Each frame block's observed voxels go to its own range of voxels_per_block_ entries, in
-  // voxel order, and are gathered after the pass. (One entry per voxel, cleared each frame and
-  // then compacted, was 6 MB written and scanned on one core per frame at 1 cm, where 13 % of
-  // the voxels have a surface.)
+  // voxel order, and are gathered after the pass, so no per-voxel array is cleared and scanned
+  // each frame (at 1 cm only 13 % of the voxels have a surface).
   const std::size_t entries = frame_blocks_.size() * voxels_per_block_;
   if (visible_by_block_.size() < entries) visible_by_block_.resize(entries);
   visible_in_block_.assign(frame_blocks_.size(), 0);
@@ -558,8 +552,8 @@ const std::vector<VisibleVoxel>& ObservationGrid::collect(
       const Eigen::Vector3i first_voxel = hash_.block(block) * side_;
       // Two passes over the block's voxels: the first refreshes surfaces, projects them and asks
       // for the depth under each; the second tests visibility. Voxels come in block order, which
-      // scatters their pixels over images larger than the cache: the depth and colour reads were
-      // a third of this loop's own time (prefetched: 0.3-0.5 ms less per frame on cubes, office).
+      // scatters their pixels over images larger than the cache, so the depth and colour reads
+      // are prefetched.
       for (int local = 0; local < voxels_per_block_; ++local) {
         const Eigen::Vector3i offset = local_coordinates(local);
         const int v = block * voxels_per_block_ + local;

@@ -27,12 +27,9 @@ namespace glint::reflectance {
 
 struct ReflectanceParams {
   fusion::FusionParams geometry{.volume = reflectance_volume_params(), .tracking = {}};
-  // Observations 1 degree apart at least (ObservationGridParams::min_observation_spacing_deg;
-  // chosen on cubes, where 1 degree changed no metric beyond run-to-run spread and 2 degrees
-  // cost 0.3 dB refined RGB; office held out: +0.8 dB, observation stage -3.6 ms per frame),
-  // or 2 frames apart (spacing_max_frames). With the spacing alone the slow hand-held camera of
-  // 7-Scenes' kitchen (50 frames) gave 9 of its 101 segments a material (every observation: 67;
-  // 2 frames: 58; 4 frames: 48); the synthetic scenes' metrics stay within their spread.
+  // Observations 1 degree apart at least (ObservationGridParams::min_observation_spacing_deg):
+  // far voxels otherwise fill their slots with near-duplicate views; or 2 frames apart
+  // (spacing_max_frames), so a slow hand-held camera still collects enough (docs/decisions.md).
   ObservationGridParams observations{.min_observation_spacing_deg = 1.0, .spacing_max_frames = 2};
   DepthSegmentationParams segmentation;  // min_segment_px at full resolution
   // The depth segmentation runs on the depth image halved this many times (KinectFusion's
@@ -46,8 +43,8 @@ struct ReflectanceParams {
   // little, and the paper's per-frame cost on a GPU is 4x ours per voxel on 2 CPU cores.
   int albedo_refresh_frames = 4;
   // How a voxel's per-observation albedos are combined (reflectance/albedo_refinement.h). The
-  // median, chosen on the cubes scene (refined-kd L1 0.044 -> 0.041, refined-RGB PSNR +0.3 dB
-  // over the paper's mean), departs from the paper's mean; --albedo-average mean restores it.
+  // median resists observations whose highlight ks, alpha mispredict; it departs from the
+  // paper's mean, which --albedo-average mean restores.
   AlbedoAverage albedo_average = AlbedoAverage::median;
   // Whether eq. (7) takes observations with a clipped channel where a voxel has others too (the
   // paper). By default they are left out: a clipped channel's albedo comes out too dark
@@ -63,11 +60,8 @@ struct ReflectanceParams {
   // Re-renderings and the mesh smooth the refined albedo between neighbouring voxels that agree
   // to about this relative contrast (interpolate_refined_kd in reflectance/material_maps.h);
   // 0 interpolates trilinearly only, as the paper. On a uniform surface a voxel's eq. (7) albedo
-  // scatters by a few per cent (cubes, 300 frames: interquartile range 1-3.5 % of the median
-  // per cube). Chosen on cubes, which has no texture, so any value smooths (refined-kd L1
-  // 0.0169 off, 0.0157 / 0.0152 / 0.0147 / 0.0145 at 0.05 / 0.1 / 0.2 / no range weight); 0.2
-  // rather than no limit, to keep textures' contrast. Bunnies and the textured office were held
-  // out (docs/reflectance/history.md, "Session of 2026-11-27 (second)").
+  // scatters by a few per cent; 0.2 rather than no limit keeps textures' contrast
+  // (docs/decisions.md).
   float albedo_smoothing = 0.2f;
   // Radiance = pixel colour / exposure; the lights are in the same radiance units
   // (reflectance/light_estimation.h).

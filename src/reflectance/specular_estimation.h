@@ -30,9 +30,9 @@ struct SpecularParams {
   int min_observations = 5;  // a sampled voxel needs this many observations
   // A segment with fewer qualifying voxels than voxels_per_estimate, but at least this many,
   // repeats them in turn to fill the network's branches (its mean pooling then weighs each about
-  // equally; the lobe fit likewise), so that small segments get a material (7-Scenes' kitchen,
-  // 50 frames: 58 -> 63 of its 101 segments); the paper's sampling is silent on them. Equal to
-  // voxels_per_estimate: only segments with enough distinct voxels, as before.
+  // equally; the lobe fit likewise), so that small segments get a material; the paper's
+  // sampling is silent on them. Equal to voxels_per_estimate: only segments with enough distinct
+  // voxels.
   int min_distinct_voxels = 8;
   int fusion_divisor = 60;  // clamp of the running mean's divisor
   bool fit_lobe = true;     // false: the paper's HemiCNN-only estimate

@@ -55,7 +55,7 @@
 
 namespace glint::render {
 
-// $GLINT_DATA when set, else "../shared/data" (DESIGN.md "Data").
+// $GLINT_DATA when set, else "../shared/data" (docs/design.md "Data").
 std::string default_data_dir();
 
 // The Kinect v2 camera (core/camera.h) scaled to `width`; a height other than 424 * scale keeps

@@ -16,7 +16,12 @@ inline std::uint64_t mix64(std::uint64_t x) {
 }
 
 // Keys that keep the streams of different uses of the same pixel independent.
-enum class RandomPurpose : std::uint64_t { colour_noise = 1, depth_noise = 2, environment = 3 };
+enum class RandomPurpose : std::uint64_t {
+  colour_noise = 1,
+  depth_noise = 2,
+  environment = 3,
+  indirect = 4
+};
 
 class PixelRandom {
  public:

@@ -9,6 +9,7 @@
 #include "render/embree_scene.h"
 #include "render/environment_map.h"
 #include "render/random.h"
+#include "render/ward_sampling.h"
 
 namespace glint::render {
 namespace {
@@ -161,29 +162,99 @@ struct Renderer::Impl {
                         const std::uint8_t* light_visible, std::size_t stride, std::uint64_t pixel,
                         int frame_index) const {
     Eigen::Vector3f radiance = Eigen::Vector3f::Zero();
-    const Eigen::Vector3f& n = hit.shading_normal;
-    for (std::size_t l = 0; l < scene.lights.size(); ++l) {
-      if (!light_visible[l * stride]) continue;
-      const LightPath path = light_path(hit, scene.lights[l]);
-      radiance += (scene.lights[l].intensity / path.distance2)
-                      .cwiseProduct(ward_brdf(material, n, path.wi, wo)) *
-                  n.dot(path.wi);
-    }
+    for (std::size_t l = 0; l < scene.lights.size(); ++l)
+      if (light_visible[l * stride])
+        radiance += point_light(hit, material, wo, light_path(hit, scene.lights[l]), l);
     if (!environment) return radiance;
     const int samples = std::max(1, scene.environment->samples);
     PixelRandom random(scene.seed, frame_index, pixel, RandomPurpose::environment);
     Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-    for (int s = 0; s < samples; ++s) {
-      const EnvironmentSample sample = environment->sample(random.uniform(), random.uniform());
-      const float cos_i = n.dot(sample.direction);
-      if (cos_i <= 0.0f || hit.geometric_normal.dot(sample.direction) <= 0.0f) continue;
-      if (scene.shadows &&
-          occluded(embree.shadow_scene(), shadow_origin(hit), sample.direction, kInfinity))
-        continue;
-      sum += sample.radiance.cwiseProduct(ward_brdf(material, n, sample.direction, wo)) *
-             (cos_i / sample.pdf);
-    }
+    for (int s = 0; s < samples; ++s) sum += environment_sample(hit, material, wo, random);
     return radiance + sum / float(samples);
+  }
+
+  // Light l's term of eq. (1): I / r^2 f(wi, wo) cos(theta_i), visibility already decided.
+  Eigen::Vector3f point_light(const Hit& hit, const WardMaterial& material,
+                              const Eigen::Vector3f& wo, const LightPath& path,
+                              std::size_t l) const {
+    const Eigen::Vector3f& n = hit.shading_normal;
+    return (scene.lights[l].intensity / path.distance2)
+               .cwiseProduct(ward_brdf(material, n, path.wi, wo)) *
+           n.dot(path.wi);
+  }
+
+  // One importance sample of the environment's term (its estimate's mean is the term).
+  Eigen::Vector3f environment_sample(const Hit& hit, const WardMaterial& material,
+                                     const Eigen::Vector3f& wo, PixelRandom& random) const {
+    const Eigen::Vector3f& n = hit.shading_normal;
+    const EnvironmentSample sample = environment->sample(random.uniform(), random.uniform());
+    const float cos_i = n.dot(sample.direction);
+    if (cos_i <= 0.0f || hit.geometric_normal.dot(sample.direction) <= 0.0f)
+      return Eigen::Vector3f::Zero();
+    if (scene.shadows &&
+        occluded(embree.shadow_scene(), shadow_origin(hit), sample.direction, kInfinity))
+      return Eigen::Vector3f::Zero();
+    return sample.radiance.cwiseProduct(ward_brdf(material, n, sample.direction, wo)) *
+           (cos_i / sample.pdf);
+  }
+
+  // Direct light at a path vertex: every point light with its own shadow ray (when the scene
+  // has shadows) and one environment sample.
+  Eigen::Vector3f vertex_direct(const Hit& hit, const WardMaterial& material,
+                                const Eigen::Vector3f& wo, PixelRandom& random) const {
+    Eigen::Vector3f radiance = Eigen::Vector3f::Zero();
+    for (std::size_t l = 0; l < scene.lights.size(); ++l) {
+      const LightPath path = light_path(hit, scene.lights[l]);
+      if (!path.faces_light) continue;
+      if (scene.shadows && occluded(embree.shadow_scene(), shadow_origin(hit), path.wi,
+                                    path.distance * (1.0f - kShadowOffsetM)))
+        continue;
+      radiance += point_light(hit, material, wo, path, l);
+    }
+    if (environment) radiance += environment_sample(hit, material, wo, random);
+    return radiance;
+  }
+
+  // Indirect light at the camera's hit (the rendering equation's remaining terms up to
+  // scene.bounces further vertices): scene.indirect_samples paths per pixel, each direction
+  // drawn from the Ward mixture (render/ward_sampling.h), next-event estimation at every vertex
+  // after the first. Emission reaches the path only through next-event estimation: bounce rays
+  // trace the shadow scene, so they pass through light proxies (the point lights they stand
+  // for are sampled directly), and a ray that leaves the scene adds nothing (the environment
+  // is sampled directly too); no light is counted twice. A fixed length, no Russian roulette.
+  Eigen::Vector3f indirect(const Hit& first_hit, const WardMaterial& first_material,
+                           const Eigen::Vector3f& first_wo, std::uint64_t pixel,
+                           int frame_index) const {
+    PixelRandom random(scene.seed, frame_index, pixel, RandomPurpose::indirect);
+    RTCIntersectContext incoherent = context(false);
+    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+    for (int s = 0; s < scene.indirect_samples; ++s) {
+      Hit hit = first_hit;
+      WardMaterial material = first_material;
+      Eigen::Vector3f wo = first_wo;
+      Eigen::Vector3f throughput = Eigen::Vector3f::Ones();
+      for (int bounce = 0; bounce < scene.bounces; ++bounce) {
+        const float u_lobe = random.uniform(), u1 = random.uniform(), u2 = random.uniform();
+        const BrdfSample sample =
+            sample_ward_brdf(material, hit.shading_normal, wo, u_lobe, u1, u2);
+        if (sample.pdf <= 0.0f || hit.geometric_normal.dot(sample.direction) <= 0.0f) break;
+        throughput = throughput.cwiseProduct(sample.weight);
+        const Eigen::Vector3f origin = shadow_origin(hit);
+        RTCRayHit ray_hit;
+        ray_hit.ray = make_ray(origin, sample.direction, kInfinity);
+        ray_hit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        ray_hit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(embree.shadow_scene(), &incoherent, &ray_hit);
+        if (ray_hit.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
+        const Surface& surface = embree.surface(ray_hit.hit.geomID);
+        hit = surface_hit(surface, ray_hit, origin, sample.direction);
+        material = surface.material;
+        material.kd = hit.kd;
+        wo = -sample.direction;
+        sum += throughput.cwiseProduct(vertex_direct(hit, material, wo, random));
+      }
+    }
+    return sum / float(scene.indirect_samples);
   }
 
   // Which pixels of the row see each light: one coherent stream of shadow rays per light.
@@ -278,6 +349,8 @@ FrameBuffers Renderer::render(const Pose& camera_to_world, int frame_index) cons
             material.kd = hit.kd;
             radiance = impl.shade(hit, material, -unit_direction, row.light_visible.data() + x,
                                   width, pixel, frame_index);
+            if (impl.scene.bounces > 0)
+              radiance += impl.indirect(hit, material, -unit_direction, pixel, frame_index);
             out.segment.plane(0)[pixel] = surface.segment_id;
             for (int c = 0; c < 3; ++c) {
               out.kd.plane(c)[pixel] = material.kd[c];

@@ -1,14 +1,23 @@
 #pragma once
-// Direct-lighting ray caster for render::Scene on Embree 3: one camera ray through each pixel
-// centre, shaded with the Ward BRDF (paper 1 eqs 2-4) under the scene's near-field point lights
+// Ray caster and path tracer for render::Scene on Embree 3. Direct light: one camera ray
+// through each pixel centre, shaded with the Ward BRDF (paper 1 eqs 2-4) under the scene's
+// near-field point lights
 //   L_o = sum_lights  I / r^2 * f(wi, wo) * cos(theta_i)     (times visibility with shadows)
 // plus, optionally, the environment map (importance-sampled, scene.environment->samples rays
-// per pixel, seeded by scene.seed and the frame index). No interreflections, no ambient term:
-// a surface no light sees is exactly black, as the reflectance pipeline assumes.
+// per pixel, seeded by scene.seed and the frame index). With scene.bounces = 0 (the default)
+// that is all: no interreflections, no ambient term, a surface no light sees is exactly black,
+// as the reflectance pipeline assumes. With scene.bounces = N > 0 the indirect light of paths
+// up to N vertices beyond the visible one is added, path traced with scene.indirect_samples
+// paths per pixel: Ward importance sampling (render/ward_sampling.h), next-event estimation to
+// every point light (and one environment sample) at every vertex; the direct part stays exact,
+// so N = 0 gives the direct image bit for bit and N > 0 only adds the indirect estimate.
+// Every random number comes from a counter-based stream keyed by (seed, frame, pixel), so an
+// image does not depend on the thread count or scheduling.
 // Surfaces are two-sided (normals face the camera). Light proxies are emissive spheres of
-// radiance I / (pi r^2), seen by camera rays but transparent to shadow rays; their pixels get
-// depth and normal but segment 0 and zero material maps. Background: the environment's
-// radiance, or 0. Thread safety: render() is const and may run concurrently.
+// radiance I / (pi r^2), seen by camera rays but transparent to shadow and bounce rays (their
+// light arrives through the point light it stands for); their pixels get depth and normal but
+// segment 0 and zero material maps. Background: the environment's radiance, or 0.
+// Thread safety: render() is const and may run concurrently.
 #include <cstdint>
 #include <memory>
 
@@ -39,7 +48,7 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  // Renders the view from camera_to_world; frame_index seeds the environment sampling.
+  // Renders the view from camera_to_world; frame_index seeds the environment and path sampling.
   FrameBuffers render(const Pose& camera_to_world, int frame_index) const;
 
   const Scene& scene() const;

@@ -66,7 +66,11 @@ struct Scene {
   std::vector<Pose> trajectory;  // camera-to-world per frame (OpenCV camera axes)
   double frames_per_second = 30;
   bool shadows = true;
-  std::uint64_t seed = 1;  // noise seeds derive from it and the frame index
+  // Indirect light (render/renderer.h): path vertices after the one the camera sees, each lit
+  // by the point lights (and environment); 0 = direct light only, as the pipeline's model.
+  int bounces = 0;
+  int indirect_samples = 32;  // paths per pixel for the indirect part (the direct part is exact)
+  std::uint64_t seed = 1;     // noise and path seeds derive from it and the frame index
 };
 
 }  // namespace glint::render

@@ -324,9 +324,9 @@ json object_json(const Object& object) {
 Scene read_scene_json(const std::string& path) {
   const json document = io::read_json(path);
   const SceneReader reader(path);
-  reader.expect_object(
-      document, "",
-      {"objects", "lights", "environment", "camera", "trajectory", "fps", "shadows", "seed"});
+  reader.expect_object(document, "",
+                       {"objects", "lights", "environment", "camera", "trajectory", "fps",
+                        "shadows", "bounces", "indirect_samples", "seed"});
   Scene scene;
   const json& objects = reader.required(document, "objects", "");
   if (!objects.is_array()) reader.fail("objects", "expected an array");
@@ -344,6 +344,14 @@ Scene read_scene_json(const std::string& path) {
   scene.frames_per_second = reader.number_or(document, "fps", scene.frames_per_second, "");
   if (!(scene.frames_per_second > 0)) reader.fail("fps", "must be > 0");
   scene.shadows = reader.boolean_or(document, "shadows", scene.shadows, "");
+  const double bounces = reader.number_or(document, "bounces", scene.bounces, "");
+  if (bounces < 0 || bounces != std::floor(bounces))
+    reader.fail("bounces", "must be an integer >= 0");
+  scene.bounces = static_cast<int>(bounces);
+  const double samples = reader.number_or(document, "indirect_samples", scene.indirect_samples, "");
+  if (samples < 1 || samples != std::floor(samples))
+    reader.fail("indirect_samples", "must be an integer >= 1");
+  scene.indirect_samples = static_cast<int>(samples);
   if (document.contains("seed")) {
     const json& seed = document["seed"];
     if (!seed.is_number_unsigned()) reader.fail("seed", "expected a non-negative integer");
@@ -385,6 +393,8 @@ void write_scene_json(const std::string& path, const Scene& scene) {
   }
   document["fps"] = scene.frames_per_second;
   document["shadows"] = scene.shadows;
+  document["bounces"] = scene.bounces;
+  document["indirect_samples"] = scene.indirect_samples;
   document["seed"] = scene.seed;
   io::write_json(path, document);
 }

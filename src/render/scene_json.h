@@ -1,5 +1,5 @@
 #pragma once
-// scene.json <-> render::Scene. The format (README "Rendering (glint render)" documents it):
+// scene.json <-> render::Scene. The format (docs/reflectance.md, "scene.json", documents it):
 //   {
 //     "objects": [{"name", "id", "shape": "mesh|box|sphere|plane", "mesh": "bunny.obj",
 //                  "size": [x, y, z],
@@ -15,7 +15,7 @@
 //     "trajectory": [[tx, ty, tz, qx, qy, qz, qw], ...]         (camera-to-world, OpenCV axes)
 //              or {"orbit": {"center": [x, y, z], "radius": r, "height": h, "frames": n,
 //                            "revolutions": 1, "start_deg": 0}},
-//     "fps": 30, "shadows": true, "seed": 1
+//     "fps": 30, "shadows": true, "bounces": 0, "indirect_samples": 32, "seed": 1
 //   }
 // Every key but "objects" and "trajectory" is optional with scene.h's defaults. Relative paths
 // (meshes, textures, environment) resolve against the JSON file's folder; the Scene holds them

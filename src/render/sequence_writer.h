@@ -1,5 +1,5 @@
 #pragma once
-// Renders a scene's trajectory into glint's on-disk RGB-D sequence format (README "Rendering"):
+// Renders a scene's trajectory into glint's on-disk RGB-D sequence format (docs/reflectance.md):
 //   intrinsics.json (+ "depth_scale": 1000), rgb/NNNNNN.png (8-bit sRGB), depth/NNNNNN.png
 //   (uint16 z-depth in mm, 0 = none), associations.txt, groundtruth.txt (TUM, camera-to-world),
 //   gt/{depth,normal,kd,ks,alpha}/NNNNNN.exr and gt/segment/NNNNNN.png (uint16 ids), scene.json.

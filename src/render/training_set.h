@@ -5,7 +5,7 @@
 // moving along a short arc. Everything is drawn from (seed, sequence index) alone, so a set is
 // reproducible, can be extended, and an interrupted run resumes where it stopped.
 //
-// Ranges (REFERENCES.md §2.2, Pellacini et al. 2000):
+// Ranges (Pellacini et al. 2000):
 //   kd      per channel 0.05-0.9: CIELAB colour drawn uniformly (L 25-96, a and b +-80) and kept
 //           when its linear RGB falls in range (perceptually even hues and lightness);
 //   ks      from the gloss contrast c ~ U(0, 0.2): ks_i = (c + cbrt(kd_i/2))^3 - kd_i/2, with c
@@ -44,7 +44,7 @@ struct MaterialRanges {
 };
 
 struct TrainingSetParams {
-  int sequences = 1000;  // 13-15 min and ~2.1 GB on 2 cores (README "glint synth")
+  int sequences = 1000;  // 13-15 min and ~2.1 GB on 2 cores (docs/benchmarks.md)
   int frames = 30;       // per sequence
   int width = 160, height = 132;
   std::uint64_t seed = 1;

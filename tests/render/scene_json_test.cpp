@@ -32,6 +32,8 @@ Scene full_scene(const std::string& texture, const std::string& environment) {
   scene.trajectory.push_back(look_at({1, 1, 1}, {0, 0, 0}));
   scene.frames_per_second = 15;
   scene.shadows = false;
+  scene.bounces = 3;
+  scene.indirect_samples = 17;
   scene.seed = 42;
   return scene;
 }
@@ -79,6 +81,8 @@ TEST(SceneJson, RoundTripKeepsEveryField) {
   for (int f = 0; f < 2; ++f) EXPECT_TRUE(back.trajectory[f].isApprox(scene.trajectory[f], 1e-12));
   EXPECT_EQ(back.frames_per_second, 15);
   EXPECT_FALSE(back.shadows);
+  EXPECT_EQ(back.bounces, 3);
+  EXPECT_EQ(back.indirect_samples, 17);
   EXPECT_EQ(back.seed, 42u);
 }
 
@@ -110,6 +114,7 @@ TEST(SceneJson, OrbitRelativePathsAndDefaults) {
   }
   EXPECT_EQ(scene.camera.intrinsics.width, 512);  // Kinect v2 default
   EXPECT_TRUE(scene.shadows);
+  EXPECT_EQ(scene.bounces, 0);  // direct light unless asked
   EXPECT_EQ(scene.frames_per_second, 30);
 }
 
@@ -153,6 +158,12 @@ TEST(SceneJson, BadInputsNameTheFileAndTheElement) {
   const Error empty = error_reading(folder, R"({"objects": [], "trajectory": []})");
   EXPECT_EQ(empty.file(), path);
   EXPECT_EQ(empty.element(), "trajectory");
+  for (const char* bad : {R"("bounces": -1)", R"("bounces": 1.5)", R"("indirect_samples": 0)"}) {
+    const Error error =
+        error_reading(folder, std::string(R"({"objects": [], )") + bad + ", " + trajectory + "}");
+    EXPECT_EQ(error.file(), path) << bad;
+    EXPECT_NE(error.reason().find(">="), std::string::npos) << error.what();
+  }
   EXPECT_EQ(glint::test::error_of([&] { read_scene_json(folder.path("none.json")); }).file(),
             folder.path("none.json"));
 }

@@ -32,10 +32,15 @@ class CliTest : public ::testing::Test {
 
   std::string path(const std::string& name) const { return (folder_ / name).string(); }
 
+  // glint --quiet ARGUMENTS.
   CommandResult glint(const std::string& arguments) const {
+    return glint_as_given("--quiet " + arguments);
+  }
+
+  // glint ARGUMENTS, nothing added.
+  CommandResult glint_as_given(const std::string& arguments) const {
     const std::string log = path("command.log");
-    const std::string command =
-        std::string(GLINT_BINARY) + " --quiet " + arguments + " > " + log + " 2>&1";
+    const std::string command = std::string(GLINT_BINARY) + " " + arguments + " > " + log + " 2>&1";
     const int status = std::system(command.c_str());
     std::ifstream stream(log);
     return {WEXITSTATUS(status), std::string(std::istreambuf_iterator<char>(stream), {})};
