@@ -15,6 +15,9 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   # The Python module (python/) and its tests; matplotlib for examples/python.
   python3-dev python3-numpy python3-pybind11 pybind11-dev python3-pytest python3-matplotlib
+  # OpenCASCADE: CAD-kernel training data and STEP input for BoundED (src/cad).
+  libocct-foundation-dev libocct-modeling-data-dev libocct-modeling-algorithms-dev
+  libocct-data-exchange-dev
   # make package: CPack's .deb finds its shared-library dependencies with dpkg-shlibdeps and file.
   dpkg-dev file
   # The optional MPI build (-DGLINT_WITH_MPI=ON) and the MPI test, which runs mpirun.

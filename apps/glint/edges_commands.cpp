@@ -14,6 +14,7 @@ void register_edges_commands(CLI::App& app) {
   register_edges_train(*edges);
   register_edges_synth(*edges);
   register_edges_eval(*edges);
+  register_edges_label(*edges);
 }
 
 }  // namespace glint::app

@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "core/error.h"
+#include "edges/feature_index.h"
 
 namespace glint::edges {
 namespace {
@@ -18,7 +19,7 @@ namespace {
 using Vec = Eigen::Vector3d;
 using Rng = std::mt19937_64;
 constexpr double kPi = 3.14159265358979323846;
-constexpr std::uint8_t kSharp = 1, kBoundary = 2;
+constexpr std::uint8_t kSharp = kLabelSharp, kBoundary = kLabelBoundary;
 
 // Segments around a full circle: neighbouring facets differ by 3.75 degrees, far below any
 // sensible sharp angle.
@@ -305,11 +306,6 @@ void weld(Mesh& mesh) {
   mesh.triangles = std::move(triangles);
 }
 
-struct FeatureSegment {
-  Vec a, b;
-  std::uint8_t label;
-};
-
 Vec triangle_normal(const Mesh& mesh, const std::array<int, 3>& t) {
   const Vec& a = mesh.vertices[t[0]];
   return (mesh.vertices[t[1]] - a).cross(mesh.vertices[t[2]] - a).normalized();
@@ -356,61 +352,6 @@ std::vector<FeatureSegment> feature_edges(const Mesh& mesh, double sharp_angle_d
   });
   return segments;
 }
-
-double segment_distance(const Vec& p, const Vec& a, const Vec& b) {
-  const Vec ab = b - a;
-  const double length2 = ab.squaredNorm();
-  const double t = length2 > 0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
-  return (p - (a + t * ab)).norm();
-}
-
-// Label lookup: feature segments cut into pieces no longer than the largest band, hashed by
-// their midpoints on a grid whose cell covers band + half a piece, so 27 cells always suffice.
-class FeatureIndex {
- public:
-  FeatureIndex(const std::vector<FeatureSegment>& segments, double max_band)
-      : cell_(2.0 * max_band) {
-    for (const FeatureSegment& s : segments) {
-      const int pieces = std::max(1, static_cast<int>(std::ceil((s.b - s.a).norm() / max_band)));
-      for (int i = 0; i < pieces; ++i) {
-        const Vec a = s.a + (s.b - s.a) * (double(i) / pieces);
-        const Vec b = s.a + (s.b - s.a) * (double(i + 1) / pieces);
-        cells_[key(0.5 * (a + b))].push_back({a, b, s.label});
-      }
-    }
-  }
-
-  // Boundary beats sharp where both are within their bands.
-  std::uint8_t label(const Vec& p, double sharp_band, double boundary_band) const {
-    std::uint8_t result = 0;
-    const auto centre = coordinates(p);
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          const auto it = cells_.find(pack({centre[0] + dx, centre[1] + dy, centre[2] + dz}));
-          if (it == cells_.end()) continue;
-          for (const FeatureSegment& s : it->second)
-            if (s.label > result && segment_distance(p, s.a, s.b) <=
-                                        (s.label == kBoundary ? boundary_band : sharp_band))
-              result = s.label;
-        }
-    return result;
-  }
-
- private:
-  std::array<std::int64_t, 3> coordinates(const Vec& p) const {
-    return {std::int64_t(std::floor(p.x() / cell_)), std::int64_t(std::floor(p.y() / cell_)),
-            std::int64_t(std::floor(p.z() / cell_))};
-  }
-  static std::uint64_t pack(const std::array<std::int64_t, 3>& c) {
-    return (std::uint64_t(c[0] & 0x1fffff) << 42) | (std::uint64_t(c[1] & 0x1fffff) << 21) |
-           std::uint64_t(c[2] & 0x1fffff);
-  }
-  std::uint64_t key(const Vec& p) const { return pack(coordinates(p)); }
-
-  double cell_;
-  std::unordered_map<std::uint64_t, std::vector<FeatureSegment>> cells_;
-};
 
 Eigen::Matrix3d random_rotation(Rng& rng) {
   std::normal_distribution<double> normal;

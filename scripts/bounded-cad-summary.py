@@ -1,0 +1,55 @@
+#!/usr/bin/env python3
+"""Markdown tables of scripts/eval-bounded-cad.sh's reports: median MCC per method, the three
+training seeds as their median and range.
+
+    bounded-cad-summary.py WORK
+"""
+import json
+import pathlib
+import re
+import statistics
+import sys
+
+
+def row(report):
+    summary = json.loads(report.read_text())["summary"]
+    seeds, cells = [], {}
+    for name, s in summary.items():
+        mcc = s["median"]["mcc"]
+        name = name.removeprefix("glint:")
+        if re.search(r"-s\d+$", name):
+            seeds.append(mcc)
+        else:
+            cells[name] = f"{mcc:.3f}"
+    if seeds:
+        cells["new (3 seeds)"] = (f"{statistics.median(seeds):.3f} "
+                                  f"({min(seeds):.3f}-{max(seeds):.3f})")
+    return cells
+
+
+def table(title, reports):
+    rows = [(r.stem, row(r)) for r in reports]
+    if not rows:
+        return
+    columns = []
+    for _, cells in rows:
+        columns += [c for c in cells if c not in columns]
+    print(f"\n### {title}\n")
+    print("| set | " + " | ".join(columns) + " |")
+    print("|---" * (len(columns) + 1) + "|")
+    for name, cells in rows:
+        print(f"| {name} | " + " | ".join(cells.get(c, "–") for c in columns) + " |")
+
+
+def main():
+    work = pathlib.Path(sys.argv[1])
+    for classes in ("3c", "2c"):
+        table(f"sharp edges, median MCC ({classes})", sorted(work.glob(f"cad-*-sharp-{classes}.json")))
+    table("boundary, parts cut open by a plane, median MCC (3c)",
+          sorted(work.glob("cad-*-boundary-3c.json")))
+    table("default-eval and shrec19, sharp, median MCC",
+          sorted(work.glob("default-eval-*.json")) + sorted(work.glob("shrec19-*.json")))
+
+
+if __name__ == "__main__":
+    main()
