@@ -28,6 +28,7 @@
 #include <unordered_map>
 
 #include "core/error.h"
+#include "geometry/weld.h"
 
 namespace glint::cad {
 namespace {
@@ -72,34 +73,6 @@ Mesh tessellate(const TopoDS_Shape& shape, double linear_deflection, double angu
   }
   if (mesh.triangles.empty()) throw Error("tessellation", "", "the shape has no meshable faces");
   return mesh;
-}
-
-// Merges the copies of a node that adjacent faces' triangulations each hold.
-void weld(Mesh& mesh, double quantum) {
-  struct KeyHash {
-    std::size_t operator()(const std::array<std::int64_t, 3>& k) const {
-      return std::hash<std::int64_t>()(k[0] * 73856093 ^ k[1] * 19349663 ^ k[2] * 83492791);
-    }
-  };
-  std::unordered_map<std::array<std::int64_t, 3>, int, KeyHash> index;
-  std::vector<Vec> vertices;
-  std::vector<int> remap(mesh.vertices.size());
-  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
-    const Vec& v = mesh.vertices[i];
-    const std::array<std::int64_t, 3> key{std::llround(v.x() / quantum),
-                                          std::llround(v.y() / quantum),
-                                          std::llround(v.z() / quantum)};
-    const auto [it, inserted] = index.emplace(key, static_cast<int>(vertices.size()));
-    if (inserted) vertices.push_back(v);
-    remap[i] = it->second;
-  }
-  std::vector<std::array<int, 3>> triangles;
-  for (auto t : mesh.triangles) {
-    for (int& corner : t) corner = remap[corner];
-    if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) triangles.push_back(t);
-  }
-  mesh.vertices = std::move(vertices);
-  mesh.triangles = std::move(triangles);
 }
 
 // Splits triangles at the midpoint of their longest edge until no edge exceeds max_edge
@@ -182,7 +155,7 @@ Samples sample_vertices(const TopoDS_Shape& shape, const SampleParams& p, double
                         Rng& rng) {
   Mesh mesh =
       tessellate(shape, p.linear_deflection * diagonal, p.angular_deflection_deg * kPi / 180.0);
-  weld(mesh, 1e-7 * diagonal);
+  geometry::weld_vertices(mesh, 1e-7 * diagonal);
   if (p.plane_edge_fraction > 0.0) refine(mesh, p.plane_edge_fraction * diagonal);
   const std::size_t n = mesh.vertices.size();
   std::vector<Vec> normals(n, Vec::Zero());

@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "edges/feature_index.h"
+#include "geometry/weld.h"
 
 namespace glint::edges {
 namespace {
@@ -278,32 +279,7 @@ Shape build_shape(SynthShape kind, Rng& rng, int points, double sharp_angle) {
 void weld(Mesh& mesh) {
   Eigen::AlignedBox3d box;
   for (const Vec& v : mesh.vertices) box.extend(v);
-  const double quantum = 1e-9 * std::max(box.diagonal().norm(), 1e-12);
-  struct KeyHash {
-    std::size_t operator()(const std::array<std::int64_t, 3>& k) const {
-      return std::hash<std::int64_t>()(k[0] * 73856093 ^ k[1] * 19349663 ^ k[2] * 83492791);
-    }
-  };
-  std::unordered_map<std::array<std::int64_t, 3>, int, KeyHash> index;
-  std::vector<Vec> vertices;
-  std::vector<int> remap(mesh.vertices.size());
-  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
-    const Vec& v = mesh.vertices[i];
-    const std::array<std::int64_t, 3> key{std::llround(v.x() / quantum),
-                                          std::llround(v.y() / quantum),
-                                          std::llround(v.z() / quantum)};
-    const auto [it, inserted] = index.emplace(key, static_cast<int>(vertices.size()));
-    if (inserted) vertices.push_back(v);
-    remap[i] = it->second;
-  }
-  std::vector<std::array<int, 3>> triangles;
-  for (auto t : mesh.triangles) {
-    for (int& corner : t) corner = remap[corner];
-    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
-    triangles.push_back(t);
-  }
-  mesh.vertices = std::move(vertices);
-  mesh.triangles = std::move(triangles);
+  geometry::weld_vertices(mesh, 1e-9 * std::max(box.diagonal().norm(), 1e-12));
 }
 
 Vec triangle_normal(const Mesh& mesh, const std::array<int, 3>& t) {
