@@ -2,7 +2,8 @@
 # trees, runs the installed glint from there (its version report, then synth + classify with the
 # default model, which it must find under the prefix) and builds examples/cpp against the
 # installed CMake package.
-#   cmake -DBUILD_DIR=build/release -DSOURCE_DIR=. -P tests/install/install_tree_test.cmake
+#   cmake -DBUILD_DIR=build/release -DSOURCE_DIR=. [-DLIBRARY_CXX_FLAGS=... -DLIBRARY_LINKER_FLAGS=...]
+#         -P tests/install/install_tree_test.cmake
 cmake_minimum_required(VERSION 3.25)
 
 string(RANDOM LENGTH 8 suffix)
@@ -57,8 +58,11 @@ if(NOT model STREQUAL "${prefix}/share/glint/models/bounded-3c.json")
 endif()
 message(STATUS "${output}")
 
+# The example is compiled with the flags the installed libraries were (a sanitizer build's
+# libraries need its runtime linked in).
 run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples/cpp -B example -DCMAKE_PREFIX_PATH=${prefix}
-    -DCMAKE_BUILD_TYPE=Release)
+    -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS=${LIBRARY_CXX_FLAGS}"
+    "-DCMAKE_EXE_LINKER_FLAGS=${LIBRARY_LINKER_FLAGS}")
 run(${CMAKE_COMMAND} --build example)
 run(example/classify_cloud ${cloud} example.ply)
 expect("points:")
