@@ -32,8 +32,16 @@ missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# The web parts (three.js viewer, glTF validator, headless-browser checks) from web/'s lock file.
+install_web() {
+  [[ -d web/node_modules ]] && return 0
+  command -v npm >/dev/null || { echo "install-deps: npm not found; the web checks will be skipped"; return 0; }
+  (cd "$(dirname "$0")/../web" && npm ci --no-audit --no-fund --loglevel=error)
+}
+
 if [[ ${#missing[@]} -eq 0 ]]; then
   echo "install-deps: all ${#packages[@]} packages present"
+  install_web
   exit 0
 fi
 
@@ -43,3 +51,4 @@ sudo_cmd=()
 export DEBIAN_FRONTEND=noninteractive
 "${sudo_cmd[@]}" apt-get update -qq
 "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+install_web
