@@ -34,9 +34,11 @@ for p in "${packages[@]}"; do
 done
 # The web parts (three.js viewer, glTF validator, headless-browser checks) from web/'s lock file.
 install_web() {
-  [[ -d web/node_modules ]] && return 0
+  local web
+  web="$(dirname "$0")/../web"
+  [[ -d "$web/node_modules" ]] && return 0
   command -v npm >/dev/null || { echo "install-deps: npm not found; the web checks will be skipped"; return 0; }
-  (cd "$(dirname "$0")/../web" && npm ci --no-audit --no-fund --loglevel=error)
+  (cd "$web" && npm ci --no-audit --no-fund --loglevel=error)
 }
 
 if [[ ${#missing[@]} -eq 0 ]]; then
