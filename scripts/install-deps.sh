@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package glint's build needs (idempotent: only what is missing).
 # Usage: scripts/install-deps.sh [--peers]   (--peers adds the comparison-only libraries for bench/)
+# Blender (scripts/blender-render-glb.py, a benchmark step) is not installed here:
+# apt-get install blender.
 set -euo pipefail
 
 packages=(
@@ -22,6 +24,9 @@ packages=(
   dpkg-dev file
   # The optional MPI build (-DGLINT_WITH_MPI=ON) and the MPI test, which runs mpirun.
   libopenmpi-dev openmpi-bin
+  # The viewer's browser test (ctest viewer.page_in_chromium) and scripts/compare-viewer.py:
+  # headless Chromium driven by puppeteer-core (~115 MB to download, ~360 MB installed).
+  chromium
 )
 if [[ "${1:-}" == "--peers" ]]; then
   # libopenmpi-dev: Debian's PCL loads VTK, whose CMake package needs MPI's C target.

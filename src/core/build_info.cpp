@@ -29,7 +29,8 @@ std::string describe_build() {
   return "glint " + info.version + "\n" +
          "CUDA: " + (info.cuda ? "compiled in" : "not compiled in (GLINT_WITH_CUDA=OFF)") + "\n" +
          "MPI: " + (info.mpi ? "compiled in" : "not compiled in (GLINT_WITH_MPI=OFF)") + "\n" +
-         "models: " + located(models_directory) + "\n" + "plugins: " + located(plugin_directory);
+         "models: " + located(models_directory) + "\n" + "plugins: " + located(plugin_directory) +
+         "\n" + "viewer page: " + located(web_directory);
 }
 
 }  // namespace glint

@@ -85,6 +85,15 @@ fs::path models_directory() {
   return found;
 }
 
+fs::path web_directory() {
+  if (fs::path folder = directory_from("GLINT_WEB_DIR"); !folder.empty()) return folder;
+  std::vector<std::string> searched;
+  const fs::path found = find_below_prefixes(fs::path("share") / "glint" / "web", searched);
+  if (found.empty())
+    throw Error("", "", "no viewer page found (set GLINT_WEB_DIR); searched " + join(searched));
+  return found;
+}
+
 fs::path model_path(const std::string& file_name) {
   const fs::path path = models_directory() / file_name;
   if (!fs::exists(path)) throw Error(path.string(), "", "no such model");

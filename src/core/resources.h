@@ -1,15 +1,17 @@
 #pragma once
-// Where glint's installed files are: the shipped models and the loadable modules (plugins).
+// Where glint's installed files are: the shipped models, the viewer's web page and the loadable
+// modules (plugins).
 // They are found relative to the running glint code, never through a path compiled in, so an
 // installed or moved glint works from anywhere:
 //   <prefix>/bin/glint                                   the executable
 //   <prefix>/lib/glint/<plugin>.so                       the plugins
 //   <prefix>/share/glint/models/                         the models
+//   <prefix>/share/glint/web/                            the viewer page and its three.js modules
 //   <prefix>/lib/python3/dist-packages/glint/<module>.so  the Python extension module
 // <prefix> is the nearest of the kMaxPrefixLevels folders above the folder of the file holding
 // the running code (the executable, or the shared object glint_core was linked into, such as
 // the Python module or a plugin) that holds the wanted file. The build tree has the same layout:
-// build/<preset>/share/glint/models and build/<preset>/lib/glint.
+// build/<preset>/share/glint/models, build/<preset>/share/glint/web and build/<preset>/lib/glint.
 // Environment variables override each location.
 #include <filesystem>
 #include <string>
@@ -36,6 +38,11 @@ std::filesystem::path models_directory();
 // A shipped model: models_directory() / file_name. Throws glint::Error naming the path when
 // the file is missing.
 std::filesystem::path model_path(const std::string& file_name);
+
+// The viewer page's folder (index.html, viewer.js, three/: the three.js modules it imports):
+// $GLINT_WEB_DIR, else the first <prefix>/share/glint/web of candidate_prefixes() that exists.
+// Throws glint::Error that names the variable (when it names no folder) or every folder searched.
+std::filesystem::path web_directory();
 
 // One of glint's loadable modules (the libtorch parts, kept out of the executable's start-up).
 // Each module's header names its own (e.g. edges/train_plugin.h).

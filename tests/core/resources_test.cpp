@@ -20,8 +20,8 @@ namespace fs = std::filesystem;
 class Resources : public ::testing::Test {
  protected:
   void SetUp() override {
-    for (const char* variable :
-         {"GLINT_MODELS_DIR", "GLINT_MODELS", "GLINT_PLUGIN_DIR", "GLINT_TEST_PLUGIN"})
+    for (const char* variable : {"GLINT_MODELS_DIR", "GLINT_MODELS", "GLINT_PLUGIN_DIR",
+                                 "GLINT_TEST_PLUGIN", "GLINT_WEB_DIR"})
       unsetenv(variable);
     folder_ = fs::temp_directory_path() /
               ("glint_resources_test_" +
@@ -31,8 +31,8 @@ class Resources : public ::testing::Test {
     fs::create_directories(folder_);
   }
   void TearDown() override {
-    for (const char* variable :
-         {"GLINT_MODELS_DIR", "GLINT_MODELS", "GLINT_PLUGIN_DIR", "GLINT_TEST_PLUGIN"})
+    for (const char* variable : {"GLINT_MODELS_DIR", "GLINT_MODELS", "GLINT_PLUGIN_DIR",
+                                 "GLINT_TEST_PLUGIN", "GLINT_WEB_DIR"})
       unsetenv(variable);
     fs::remove_all(folder_);
   }
@@ -74,6 +74,18 @@ TEST_F(Resources, EnvironmentOverridesTheModelsFolder) {
   const Error error = test::error_of([] { models_directory(); });
   EXPECT_NE(error.file().find("$GLINT_MODELS_DIR="), std::string::npos) << error.what();
   EXPECT_NE(error.file().find("missing"), std::string::npos) << error.what();
+}
+
+TEST_F(Resources, WebFolderIsFoundInTheBuildTreeOrThroughTheEnvironment) {
+  // The build tree's share/glint/web holds the page (and the three.js modules where
+  // web/node_modules was installed when CMake ran).
+  EXPECT_EQ(web_directory(), candidate_prefixes()[0] / "share" / "glint" / "web");
+  EXPECT_TRUE(fs::exists(web_directory() / "index.html"));
+  setenv("GLINT_WEB_DIR", folder_.c_str(), 1);
+  EXPECT_EQ(web_directory(), folder_);
+  setenv("GLINT_WEB_DIR", (folder_ / "missing").c_str(), 1);
+  const Error error = test::error_of([] { web_directory(); });
+  EXPECT_NE(error.file().find("$GLINT_WEB_DIR="), std::string::npos) << error.what();
 }
 
 TEST_F(Resources, PluginSearchNamesEveryPlaceAndVariable) {

@@ -17,8 +17,8 @@ file(MAKE_DIRECTORY ${work})
 function(run)
   execute_process(
     COMMAND ${CMAKE_COMMAND} -E env --unset=GLINT_MODELS_DIR --unset=GLINT_MODELS
-            --unset=GLINT_PLUGIN_DIR --unset=GLINT_TRAIN_PLUGIN --unset=GLINT_DENOISE_PLUGIN
-            --unset=GLINT_HEMICNN_PLUGIN ${ARGN}
+            --unset=GLINT_PLUGIN_DIR --unset=GLINT_WEB_DIR --unset=GLINT_TRAIN_PLUGIN
+            --unset=GLINT_DENOISE_PLUGIN --unset=GLINT_HEMICNN_PLUGIN ${ARGN}
     WORKING_DIRECTORY ${work} RESULT_VARIABLE status OUTPUT_VARIABLE out ERROR_VARIABLE out)
   if(NOT status EQUAL 0)
     message(FATAL_ERROR "failed (${status}): ${ARGN}\n${out}")
@@ -45,6 +45,15 @@ endforeach()
 run(${prefix}/bin/glint --version)
 expect("models: ${prefix}/share/glint/models")
 expect("plugins: ${prefix}/lib/glint")
+expect("viewer page: ${prefix}/share/glint/web")
+# The viewer's three.js modules are installed where web/node_modules was there when CMake ran.
+if(EXISTS ${SOURCE_DIR}/web/node_modules/three/package.json)
+  foreach(file index.html viewer.js three/three.module.min.js three/addons/loaders/GLTFLoader.js)
+    if(NOT EXISTS ${prefix}/share/glint/web/${file} OR IS_SYMLINK ${prefix}/share/glint/web/${file})
+      message(FATAL_ERROR "not installed as a file: ${prefix}/share/glint/web/${file}")
+    endif()
+  endforeach()
+endif()
 message(STATUS "${output}")
 
 run(${prefix}/bin/glint --quiet edges synth -o clouds --count 1 --seed 4 --min-points 1500
