@@ -13,6 +13,8 @@ packages=(
   libtorch-dev libopenblas0-openmp
   libopencv-dev
   libembree-dev libtinyobjloader-dev
+  # glTF scene export: mesh simplification.
+  libmeshoptimizer-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   # The Python module (python/) and its tests; matplotlib for examples/python.

@@ -49,6 +49,8 @@ void register_hemicnn_probe(CLI::App& hemicnn);
 void register_reconstruct_command(CLI::App& app);
 // `glint lights CAPTURE -o lights.json` (apps/glint/lights_command.cpp).
 void register_lights_command(CLI::App& app);
+// `glint export RECONSTRUCTION -o scene.glb` (apps/glint/export_command.cpp).
+void register_export_command(CLI::App& app);
 // `glint view OUT [--port P] [--write-html DIR]` (apps/glint/view_command.cpp).
 void register_view_command(CLI::App& app);
 

@@ -57,6 +57,7 @@ int main(int argc, char** argv) {
   glint::app::register_reconstruct_command(app);
   glint::app::register_hemicnn_commands(app);
   glint::app::register_lights_command(app);
+  glint::app::register_export_command(app);
   glint::app::register_view_command(app);
 
   std::unique_ptr<tbb::global_control> thread_limit;

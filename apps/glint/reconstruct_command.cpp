@@ -28,6 +28,7 @@
 #include "reflectance/reconstruction_outputs.h"
 #include "reflectance/reflectance_pipeline.h"
 #include "render/scene_json.h"
+#include "scene_export_options.h"
 #include "volume_options.h"
 
 namespace glint::app {
@@ -64,6 +65,8 @@ struct ReconstructOptions {
   int render_every = 0;  // 0: only the last frame
   std::string views;     // TUM trajectory of extra poses to re-render at the end
   float render_normal_radius_m = reflectance::kRenderNormalRadiusM;
+  bool glb = true;  // OUT/scene.glb
+  SceneExportOptions scene;
   reflectance::ReflectanceParams params;
 };
 
@@ -86,6 +89,7 @@ reflectance::LightEstimate load_lights(const ReconstructOptions& options) {
 
 void run_reconstruct(ReconstructOptions options) {
   Stopwatch total;
+  scene_export_params(options.scene);  // an unknown --up fails before the long run
   const io::RgbdSequence sequence = io::open_rgbd_sequence(options.sequence);
   const std::size_t frames =
       options.frames ? std::min(options.frames, sequence.frames.size()) : sequence.frames.size();
@@ -172,6 +176,13 @@ void run_reconstruct(ReconstructOptions options) {
   Stopwatch watch;
   reflectance::write_reconstruction(staging, pipeline, lights);
   command_timings.add("mesh", watch.elapsed_ms());
+  nlohmann::json glb_report = nullptr;
+  if (options.glb) {
+    // From the files just written, as `glint export OUT` would: both give the same scene.glb.
+    watch.restart();
+    glb_report = export_scene(staging, (fs::path(staging) / "scene.glb").string(), options.scene);
+    command_timings.add("glb", watch.elapsed_ms());
+  }
   if (has_truth && !evaluation.series().empty()) {
     write_material_plots((fs::path(staging) / "materials-over-time.png").string(), evaluation,
                          options.evaluate_every);
@@ -253,6 +264,7 @@ void run_reconstruct(ReconstructOptions options) {
        {"material_coverage",
         {{"segments", coverage.segments}, {"without_material", coverage.without_material}}},
        {"evaluation", has_truth ? evaluation.to_json() : nlohmann::json(nullptr)},
+       {"scene_glb", glb_report},
        {"total_s", total.elapsed_s()}});
 }
 
@@ -271,8 +283,9 @@ void register_reconstruct_command(CLI::App& app) {
       "time, and refines the diffuse albedo per voxel (eq. 7) under the estimated point lights.\n"
       "Writes OUT/mesh.ply (per vertex: refined kd as colour; kd_r/g/b, ks_r/g/b, alpha,\n"
       "scalar_segment as floats), OUT/materials.json, OUT/lights.json, OUT/frames/ (input,\n"
-      "re-rendering, albedo), and on synthetic sequences with gt/ the paper's Table 1 metrics\n"
-      "and OUT/materials-over-time.png.");
+      "re-rendering, albedo), OUT/scene.glb (glTF 2.0: mesh, materials, lights; as `glint\n"
+      "export`), and on synthetic sequences with gt/ the paper's Table 1 metrics and\n"
+      "OUT/materials-over-time.png.");
   command->add_option("sequence", options->sequence, "RGB-D sequence folder")->required();
   command
       ->add_option("-o,--output", options->output,
@@ -332,6 +345,8 @@ void register_reconstruct_command(CLI::App& app) {
                    "face (0 = per-pixel normals of the ray cast)")
       ->capture_default_str()
       ->check(kNonNegative);
+  command->add_flag("!--no-glb", options->glb, "Do not write OUT/scene.glb");
+  add_scene_export_options(command, options->scene);
   command->add_option("--views", options->views,
                       "TUM trajectory (camera-to-world) of extra poses to re-render the final "
                       "model from, into OUT/views/");

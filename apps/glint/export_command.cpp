@@ -1,0 +1,101 @@
+// glint export: a reconstruction folder as one glTF 2.0 binary (src/gltf/scene_export.h), the
+// file `glint reconstruct` also writes as OUT/scene.glb.
+#include <filesystem>
+
+#include "cli_support.h"
+#include "commands.h"
+#include "core/log.h"
+#include "core/timer.h"
+#include "io/json_report.h"
+#include "scene_export_options.h"
+
+namespace glint::app {
+
+void add_scene_export_options(CLI::App* command, SceneExportOptions& options) {
+  command
+      ->add_option("--mesh-triangles", options.params.mesh_triangles,
+                   "scene.glb: simplify the TSDF mesh to at most this many triangles "
+                   "(meshoptimizer; 0 = full resolution)")
+      ->capture_default_str();
+  command
+      ->add_option("--texture-size", options.params.texture_size,
+                   "scene.glb: side of the baked kd atlas, texels (one density for the whole "
+                   "scene; 0 = no texture, per-vertex COLOR_0 instead)")
+      ->check(kNonNegative)
+      ->capture_default_str();
+  command
+      ->add_option("--up", options.up,
+                   "scene.glb: the axis of glint's world that points up (+y for glint's "
+                   "synthetic scenes; -y for a sequence whose world is its first camera, e.g. "
+                   "7-Scenes); the root node turns it into glTF's +Y")
+      ->capture_default_str();
+}
+
+gltf::ExportParams scene_export_params(const SceneExportOptions& options) {
+  gltf::ExportParams params = options.params;
+  params.up = gltf::parse_up_axis(options.up);
+  return params;
+}
+
+nlohmann::json export_scene(const std::string& folder, const std::string& path,
+                            const SceneExportOptions& options) {
+  const gltf::ExportParams params = scene_export_params(options);
+  Stopwatch watch;
+  const gltf::Reconstruction scene = gltf::read_reconstruction(folder);
+  const gltf::ExportStats stats = gltf::write_scene_glb(scene, params, path);
+  const double seconds = watch.elapsed_s();
+  const auto bytes = std::filesystem::file_size(path);
+  log().info(
+      "scene.glb: {} of {} triangles (deviation {:.1f} mm), {} materials, {} lights, {} charts at "
+      "{:.0f} texels/m, {:.1f} MB in {:.1f} s",
+      stats.triangles, stats.input_triangles, 1e3 * stats.simplification_error_m, stats.materials,
+      stats.lights, stats.charts, stats.texels_per_metre, bytes / 1e6, seconds);
+  nlohmann::json report = stats.to_json();
+  report["seconds"] = seconds;
+  report["bytes"] = bytes;
+  return report;
+}
+
+namespace {
+
+struct ExportCommandOptions {
+  std::string folder, output, report;
+  SceneExportOptions scene;
+};
+
+}  // namespace
+
+void register_export_command(CLI::App& app) {
+  auto options = std::make_shared<ExportCommandOptions>();
+  CLI::App* command = app.add_subcommand(
+      "export",
+      "A reconstruction (the folder `glint reconstruct` wrote) as one glTF 2.0 binary for\n"
+      "three.js, Blender, Unity: the mesh simplified to a budget, one material per segment\n"
+      "(metallic 0; base colour = the refined kd, baked into a texture atlas; ks as\n"
+      "KHR_materials_specular; roughness from Ward's alpha, roughness = sqrt(0.918 alpha); the\n"
+      "raw Ward values in the material's extras), the segment id per vertex (_SEGMENT), the\n"
+      "lights as KHR_lights_punctual point lights (candela = glint's intensity), metres, +Y up.\n"
+      "`glint reconstruct` writes the same file as OUT/scene.glb.");
+  command->add_option("reconstruction", options->folder, "Reconstruction folder")->required();
+  command->add_option("-o,--output", options->output, "GLB file to write")
+      ->required()
+      ->check(kOutputFile);
+  add_scene_export_options(command, options->scene);
+  command->add_option("--report", options->report, "JSON report: counts, sizes, seconds")
+      ->check(kOutputFile);
+  command->footer(
+      "Examples:\n"
+      "  glint export out/bunnies -o bunnies.glb\n"
+      "  glint export out/kitchen -o kitchen.glb --up -y --mesh-triangles 100000\n"
+      "  glint export out/office -o office-full.glb --mesh-triangles 0 --texture-size 4096\n"
+      "Check a file: node web/node_modules/gltf-validator (see docs/reflectance.md, Export).");
+  command->callback([options] {
+    nlohmann::json report = export_scene(options->folder, options->output, options->scene);
+    if (options->report.empty()) return;
+    report["command"] = command_line();
+    report["input"] = options->folder;
+    io::write_json(options->report, report);
+  });
+}
+
+}  // namespace glint::app

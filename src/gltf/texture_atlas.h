@@ -1,0 +1,58 @@
+#pragma once
+// A texture atlas for a triangle mesh: charts, packing, baking.
+// Charts: edge-connected triangles of one group (the segment) whose face normals share their
+// dominant axis (one of ±x, ±y, ±z), projected orthographically onto the plane of the other two
+// axes, so every chart keeps the same texel density (texels per metre) and at most a
+// 1/sqrt(3) shear. Packing: the charts' bounding rectangles, each with a gutter, on shelves,
+// tallest first, at the largest density (searched downwards in 2 % steps) that fits the square
+// atlas. Seams: a chart's texels are baked from the surface under their centres, then dilated
+// `gutter` texels into the empty ones around, so bilinear filtering at a chart's border never
+// reads an unbaked texel or another chart's (use no mipmaps: coarser levels would mix charts).
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "core/image.h"
+
+namespace glint::gltf {
+
+struct AtlasParams {
+  int size = 2048;  // texels per side
+  int gutter = 2;   // empty texels around each chart, filled by dilation
+};
+
+struct AtlasLayout {
+  int size = 0;
+  float texels_per_metre = 0;
+  int charts = 0;
+  // Output vertices (a mesh vertex is split where charts meet): the mesh vertex each copies,
+  // its chart and its texture coordinate (glTF's: (0, 0) the image's top-left corner).
+  std::vector<std::uint32_t> source_vertex;
+  std::vector<std::uint32_t> chart;
+  std::vector<Eigen::Vector2f> uv;
+  // The mesh's triangles in the same order, over the output vertices.
+  std::vector<Eigen::Vector3i> triangles;
+  // Texels claimed by two triangles of one chart (a fold the projection overlaps); such texels
+  // show one of the two surfaces.
+  std::size_t overlapping_texels = 0;
+};
+
+// Charts `triangles` over `vertices` (triangle t belongs to group triangle_group[t]) and packs
+// them. Throws glint::Error when even one texel per 10 cm leaves the charts no room (too many
+// charts for `size`).
+AtlasLayout layout_atlas(const std::vector<Eigen::Vector3f>& vertices,
+                         const std::vector<Eigen::Vector3i>& triangles,
+                         const std::vector<int>& triangle_group, const AtlasParams& params = {});
+
+// The value at a surface point of triangle t (thread-safe; called in parallel).
+using SurfaceSampler = std::function<Eigen::Vector3f(const Eigen::Vector3f& point, int triangle)>;
+
+// The atlas image (3 channels, as the sampler returns them, 0 where no chart is): every texel
+// whose centre lies in a triangle gets sample(point under it); then `params.gutter` dilation
+// passes give each empty texel next to baked ones their mean (8-neighbourhood). Also fills
+// `layout.overlapping_texels`.
+ImageF bake_atlas(AtlasLayout& layout, const std::vector<Eigen::Vector3f>& vertices,
+                  const SurfaceSampler& sample, const AtlasParams& params = {});
+
+}  // namespace glint::gltf
