@@ -3,7 +3,7 @@ the export opens, lit by its lights, in a DCC tool (a benchmark step, never a te
 
   blender -b --python scripts/blender-render-glb.py -- scene.glb out.png [--samples 16]
       [--intrinsics fx,fy,cx,cy,width,height --world-to-camera m00,...,m33] [--exposure X]
-      [--threads 2]
+      [--threads 2] [--no-shadows]
 
 Without a pose the camera frames the whole model. With one it is glint's camera (as the viewer's
 URL parameters, web/viewer/viewer.js): pinhole intrinsics in pixels and the world-to-camera
@@ -38,6 +38,8 @@ def arguments():
     parser.add_argument("--world-to-camera")
     parser.add_argument("--exposure", type=float)
     parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--no-shadows", action="store_true",
+                        help="lights cast no shadows (as glint's re-renderings)")
     return parser.parse_args(argv)
 
 
@@ -60,6 +62,7 @@ def main():
         sys.exit(f"blender-render-glb: {args.glb} has no mesh")
     for light in lights:
         light.data.shadow_soft_size = 0  # glint's lights are points
+        light.data.cycles.cast_shadow = not args.no_shadows
 
     # The exposure glint stored with the scene (scenes[0].extras.glint), unless given.
     exposure = args.exposure

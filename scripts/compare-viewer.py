@@ -10,7 +10,8 @@ Runs `glint reconstruct SEQ --lights CAPTURE --gt-poses --views DIR/views.txt -o
 when DIR/out/scene.glb exists, --reuse), `glint view DIR/out --write-html DIR/site`, then
 web/tests/render-viewer.mjs once per frame. Object pixels: the input frame has depth there and
 the viewer drew the model there (the viewer renders on a magenta background for this). Writes
-DIR/compare.json and, with --figure, input | glint | viewer for the middle frame, halved.
+DIR/compare.json and, with --figure, input | glint | viewer (| Blender, with --blender) for the
+middle frame, halved.
 Needs numpy and Pillow (Debian's python3-numpy, python3-pil), node, web/node_modules, chromium.
 """
 import argparse
@@ -82,8 +83,11 @@ def main():
     parser.add_argument("--glint", default=ROOT / "build/release/apps/glint/glint")
     parser.add_argument("--frames", default="10,30,50,70,90",
                         help="frame indices (associations.txt order) to compare")
-    parser.add_argument("--figure", type=pathlib.Path, help="PNG: input | glint | viewer")
+    parser.add_argument("--figure", type=pathlib.Path, help="PNG: input | glint | viewer | Blender")
     parser.add_argument("--reuse", action="store_true", help="keep an existing WORK/out")
+    parser.add_argument("--blender", help="also render the middle frame with this Blender "
+                        "(scripts/blender-render-glb.py, Cycles, shadows off as glint)")
+    parser.add_argument("--blender-samples", type=int, default=32)
     args = parser.parse_args()
 
     frames = frame_poses(args.sequence)
@@ -132,11 +136,25 @@ def main():
             "psnr_glint_vs_input_db": psnr(glint, source, mask),
             "browser_s": browser_s,
         })
+        panels = [source, glint, viewer.copy()]
+        panels[2][~drawn] = 0  # the background as glint's (black)
+        if args.blender and view == len(chosen) // 2:
+            rendered = args.work / f"blender-{k:06d}.png"
+            start = time.perf_counter()
+            run([args.blender, "-b", "--python", ROOT / "scripts/blender-render-glb.py", "--",
+                 out / "scene.glb", rendered, "--samples", args.blender_samples, "--no-shadows",
+                 "--exposure", exposure, "--intrinsics", size, "--world-to-camera",
+                 ",".join(f"{v:.9g}" for v in world_to_camera.reshape(-1))],
+                stdout=subprocess.DEVNULL)
+            blender = read_rgb(rendered)
+            rows[-1]["blender_s"] = time.perf_counter() - start
+            rows[-1]["psnr_blender_vs_glint_db"] = psnr(blender, glint, mask)
+            rows[-1]["psnr_blender_vs_viewer_db"] = psnr(blender, viewer, mask)
+            rows[-1]["psnr_blender_vs_input_db"] = psnr(blender, source, mask)
+            panels.append(blender)
         print(json.dumps(rows[-1]), flush=True)
         if args.figure and view == len(chosen) // 2:
-            viewer_shown = viewer.copy()
-            viewer_shown[~drawn] = 0  # the background as glint's (black)
-            strip = np.concatenate([source, glint, viewer_shown], axis=1).astype(np.uint8)
+            strip = np.concatenate(panels, axis=1).astype(np.uint8)
             picture = Image.fromarray(strip)
             picture = picture.resize((picture.width // 2, picture.height // 2), Image.LANCZOS)
             args.figure.parent.mkdir(parents=True, exist_ok=True)
