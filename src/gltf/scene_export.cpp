@@ -153,7 +153,7 @@ nlohmann::json segment_material(int segment, const nlohmann::json* ward, bool te
     } catch (const nlohmann::json::exception& e) {
       throw Error("materials.json", "segment " + std::to_string(segment), e.what());
     }
-    extras["ward"] = {{"kd", ward->at("kd")}, {"ks", ward->at("ks")}, {"alpha", alpha}};
+    extras["ward"] = {{"kd", ward->at("kd")}, {"ks", ward->at("ks")}, {"alpha", ward->at("alpha")}};
     for (const char* key : {"kd_refined_mean", "estimates", "voxels", "lobe_fitted"})
       if (ward->contains(key)) extras[key] = ward->at(key);
   }
