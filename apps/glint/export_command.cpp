@@ -51,7 +51,7 @@ nlohmann::json export_scene(const std::string& folder, const std::string& path,
       stats.triangles, stats.input_triangles, 1e3 * stats.simplification_error_m, stats.materials,
       stats.lights, stats.charts, stats.texels_per_metre, bytes / 1e6, seconds);
   nlohmann::json report = stats.to_json();
-  report["seconds"] = seconds;
+  report["total_s"] = seconds;
   report["bytes"] = bytes;
   return report;
 }

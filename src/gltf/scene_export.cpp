@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "core/timer.h"
 #include "fusion/triangle_mesh.h"
 #include "geometry/kdtree.h"
 #include "gltf/material_conversion.h"
@@ -153,7 +154,7 @@ nlohmann::json segment_material(int segment, const nlohmann::json* ward, bool te
     } catch (const nlohmann::json::exception& e) {
       throw Error("materials.json", "segment " + std::to_string(segment), e.what());
     }
-    extras["ward"] = {{"kd", ward->at("kd")}, {"ks", ward->at("ks")}, {"alpha", alpha}};
+    extras["ward"] = {{"kd", ward->at("kd")}, {"ks", ward->at("ks")}, {"alpha", ward->at("alpha")}};
     for (const char* key : {"kd_refined_mean", "estimates", "voxels", "lobe_fitted"})
       if (ward->contains(key)) extras[key] = ward->at(key);
   }
@@ -229,7 +230,7 @@ Reconstruction read_reconstruction(const std::string& folder) {
   return scene;
 }
 
-nlohmann::json ExportStats::to_json() const {
+nlohmann::json ExportStats::counts_json() const {
   return {{"input_triangles", input_triangles},
           {"triangles", triangles},
           {"vertices", vertices},
@@ -241,13 +242,22 @@ nlohmann::json ExportStats::to_json() const {
           {"lights", lights}};
 }
 
+nlohmann::json ExportStats::to_json() const {
+  nlohmann::json json = counts_json();
+  json["seconds"] = {
+      {"simplify", simplify_s}, {"layout", layout_s}, {"bake", bake_s}, {"png", png_s}};
+  return json;
+}
+
 GlbBuilder build_scene_glb(const Reconstruction& scene, const ExportParams& params,
                            ExportStats* stats_out) {
   if (scene.triangles.empty()) throw Error("reconstruction", "mesh", "has no triangles");
   ExportStats stats;
   stats.input_triangles = scene.triangles.size();
+  Stopwatch watch;
   const std::vector<Eigen::Vector3i> triangles =
       simplify(scene, params.mesh_triangles, stats.simplification_error_m);
+  stats.simplify_s = watch.elapsed_s();
   stats.triangles = triangles.size();
   std::vector<int> segment_of(triangles.size());
   for (std::size_t t = 0; t < triangles.size(); ++t)
@@ -261,15 +271,21 @@ GlbBuilder build_scene_glb(const Reconstruction& scene, const ExportParams& para
   AtlasLayout layout;
   if (textured) {
     AtlasParams atlas{.size = params.texture_size};
+    watch.restart();
     layout = layout_atlas(scene.vertices, triangles, segment_of, atlas);
+    stats.layout_s = watch.elapsed_s();
+    watch.restart();
     const AlbedoSampler sampler(scene);
     const ImageF image = bake_atlas(
         layout, scene.vertices,
         [&](const Eigen::Vector3f& p, int t) { return sampler(p, segment_of[t]); }, atlas);
+    stats.bake_s = watch.elapsed_s();
     stats.charts = layout.charts;
     stats.texels_per_metre = layout.texels_per_metre;
     stats.overlapping_texels = layout.overlapping_texels;
+    watch.restart();
     const int view = glb.add_buffer_view(encode_srgb_png(image));
+    stats.png_s = watch.elapsed_s();
     doc["images"] = {{{"bufferView", view}, {"mimeType", "image/png"}, {"name", "kd_atlas"}}};
     doc["samplers"] = {{{"magFilter", kLinear},
                         {"minFilter", kLinear},
@@ -367,7 +383,7 @@ GlbBuilder build_scene_glb(const Reconstruction& scene, const ExportParams& para
   nlohmann::json extras = {{"up", up_axis_name(params.up)},
                            {"exposure", scene.materials.value("exposure", 1.0)},
                            {"light_intensity_unit", "candela = glint intensity"},
-                           {"export", stats.to_json()}};
+                           {"export", stats.counts_json()}};
   doc["scenes"] = {{{"name", "glint"}, {"nodes", {0}}, {"extras", {{"glint", extras}}}}};
   doc["scene"] = 0;
   if (stats_out) *stats_out = stats;

@@ -51,6 +51,11 @@ struct ExportStats {
   int charts = 0, materials = 0, lights = 0;
   float texels_per_metre = 0;
   std::size_t overlapping_texels = 0;
+  // Seconds per step: simplification, chart layout, baking (kNN sampling and dilation), PNG.
+  double simplify_s = 0, layout_s = 0, bake_s = 0, png_s = 0;
+  // The counts alone (what the GLB's extras carry: the same file from the same input) and with
+  // the seconds (reports).
+  nlohmann::json counts_json() const;
   nlohmann::json to_json() const;
 };
 

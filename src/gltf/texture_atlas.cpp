@@ -15,15 +15,16 @@ namespace {
 
 // Texel density below which a chart layout is refused (one texel per 10 cm).
 constexpr float kMinTexelsPerMetre = 10;
+// Texels outside a triangle whose centre is within this Chebyshev distance of it are baked too.
+constexpr float kReach = 1.0f;
 
 int find_root(std::vector<int>& parent, int i) {
   while (parent[i] != i) i = parent[i] = parent[parent[i]];
   return i;
 }
 
-// Face label: dominant axis of the face normal, 2 k + (negative).
-int face_label(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Eigen::Vector3f& c) {
-  const Eigen::Vector3f n = (b - a).cross(c - a);
+// Chart label: dominant axis of a normal, 2 k + (negative).
+int axis_label(const Eigen::Vector3f& n) {
   int k = 0;
   n.cwiseAbs().maxCoeff(&k);
   return 2 * k + (n[k] < 0);
@@ -72,10 +73,20 @@ AtlasLayout layout_atlas(const std::vector<Eigen::Vector3f>& vertices,
   if (params.size < 8 || params.gutter < 1)
     throw Error("texture atlas", "size", "needs at least 8 texels per side and a gutter of 1");
   const int n = int(triangles.size());
+  // Labels from the face's area-weighted vertex normals: a TSDF mesh's face normals are noisy
+  // at the voxel scale, and labelling by them breaks a surface near 45 degrees into many tiny
+  // charts, each paying its gutter.
+  std::vector<Eigen::Vector3f> vertex_normal(vertices.size(), Eigen::Vector3f::Zero());
+  for (const Eigen::Vector3i& f : triangles) {
+    const Eigen::Vector3f normal =
+        (vertices[f[1]] - vertices[f[0]]).cross(vertices[f[2]] - vertices[f[0]]);
+    for (int k = 0; k < 3; ++k) vertex_normal[f[k]] += normal;
+  }
   std::vector<int> label(n);
   for (int t = 0; t < n; ++t) {
     const Eigen::Vector3i& f = triangles[t];
-    label[t] = face_label(vertices[f[0]], vertices[f[1]], vertices[f[2]]);
+    label[t] = axis_label(vertex_normal[f[0]].normalized() + vertex_normal[f[1]].normalized() +
+                          vertex_normal[f[2]].normalized());
   }
   // Triangles sharing an edge, with one label and group, join a chart (union-find over the
   // sorted edge list).
@@ -167,6 +178,7 @@ ImageF bake_atlas(AtlasLayout& layout, const std::vector<Eigen::Vector3f>& verti
   const int size = layout.size;
   ImageF image(size, size, 3, 0.0f);
   std::vector<int> owner(std::size_t(size) * size, -1);
+  std::vector<float> reach(owner.size(), 0.0f);  // texels from the owner's triangle
   // Triangles per chart: charts own disjoint rectangles, so they bake in parallel.
   std::vector<std::vector<int>> chart_triangles(layout.charts);
   for (int t = 0; t < int(layout.triangles.size()); ++t)
@@ -181,10 +193,14 @@ ImageF bake_atlas(AtlasLayout& layout, const std::vector<Eigen::Vector3f>& verti
       const float area =
           (q[1] - q[0]).x() * (q[2] - q[0]).y() - (q[1] - q[0]).y() * (q[2] - q[0]).x();
       if (std::abs(area) < 1e-12f) continue;
-      const int x0 = std::max(0, int(std::floor(std::min({q[0].x(), q[1].x(), q[2].x()}))));
-      const int x1 = std::min(size - 1, int(std::ceil(std::max({q[0].x(), q[1].x(), q[2].x()}))));
-      const int y0 = std::max(0, int(std::floor(std::min({q[0].y(), q[1].y(), q[2].y()}))));
-      const int y1 = std::min(size - 1, int(std::ceil(std::max({q[0].y(), q[1].y(), q[2].y()}))));
+      const int x0 =
+          std::max(0, int(std::floor(std::min({q[0].x(), q[1].x(), q[2].x()}) - kReach)));
+      const int x1 =
+          std::min(size - 1, int(std::ceil(std::max({q[0].x(), q[1].x(), q[2].x()}) + kReach)));
+      const int y0 =
+          std::max(0, int(std::floor(std::min({q[0].y(), q[1].y(), q[2].y()}) - kReach)));
+      const int y1 =
+          std::min(size - 1, int(std::ceil(std::max({q[0].y(), q[1].y(), q[2].y()}) + kReach)));
       for (int y = y0; y <= y1; ++y)
         for (int x = x0; x <= x1; ++x) {
           const Eigen::Vector2f p(x + 0.5f, y + 0.5f);
@@ -194,14 +210,34 @@ ImageF bake_atlas(AtlasLayout& layout, const std::vector<Eigen::Vector3f>& verti
             const Eigen::Vector2f& e = q[(k + 2) % 3];
             b[k] = ((e - a).x() * (p - a).y() - (e - a).y() * (p - a).x()) / area;
           }
-          if (std::min({b[0], b[1], b[2]}) < 0) continue;
-          int& claimed = owner[std::size_t(y) * size + x];
-          if (claimed >= 0) {
-            // A texel on a shared edge is claimed twice legitimately; one well inside is a fold.
-            if (std::min({b[0], b[1], b[2]}) > 0.01f) ++overlaps;
-            continue;
+          float distance = 0;
+          if (std::min({b[0], b[1], b[2]}) < 0) {
+            // Outside: bilinear filtering of a point inside reads texels up to one texel away
+            // (Chebyshev), so texels that close are baked from the nearest point of the edge.
+            distance = std::numeric_limits<float>::max();
+            for (int k = 0; k < 3; ++k) {
+              const Eigen::Vector2f& a = q[k];
+              const Eigen::Vector2f e = q[(k + 1) % 3] - a;
+              const float s =
+                  std::clamp((p - a).dot(e) / std::max(e.squaredNorm(), 1e-12f), 0.0f, 1.0f);
+              const float d = (a + s * e - p).cwiseAbs().maxCoeff();
+              if (d < distance) {
+                distance = d;
+                b[k] = 1 - s, b[(k + 1) % 3] = s, b[(k + 2) % 3] = 0;
+              }
+            }
+            if (distance > kReach) continue;
           }
-          claimed = t;
+          const std::size_t texel = std::size_t(y) * size + x;
+          if (owner[texel] >= 0) {
+            // A texel on a shared edge is claimed twice legitimately; one well inside two
+            // triangles is a fold.
+            if (distance == 0 && reach[texel] == 0 && std::min({b[0], b[1], b[2]}) > 0.01f)
+              ++overlaps;
+            if (distance >= reach[texel]) continue;
+          }
+          owner[texel] = t;
+          reach[texel] = distance;
           const Eigen::Vector3f point = b[0] * vertices[layout.source_vertex[f[0]]] +
                                         b[1] * vertices[layout.source_vertex[f[1]]] +
                                         b[2] * vertices[layout.source_vertex[f[2]]];

@@ -1,13 +1,16 @@
 #pragma once
 // A texture atlas for a triangle mesh: charts, packing, baking.
-// Charts: edge-connected triangles of one group (the segment) whose face normals share their
-// dominant axis (one of ±x, ±y, ±z), projected orthographically onto the plane of the other two
-// axes, so every chart keeps the same texel density (texels per metre) and at most a
-// 1/sqrt(3) shear. Packing: the charts' bounding rectangles, each with a gutter, on shelves,
+// Charts: edge-connected triangles of one group (the segment) whose normals (the mean of their
+// vertices' area-weighted normals) share their dominant axis (one of ±x, ±y, ±z), projected
+// orthographically onto the plane of the other two axes, so every chart has the same texel
+// density (texels per metre) along its plane and a triangle is at most sqrt(3) times denser
+// across its slope. Packing: the charts' bounding rectangles, each with a gutter, on shelves,
 // tallest first, at the largest density (searched downwards in 2 % steps) that fits the square
-// atlas. Seams: a chart's texels are baked from the surface under their centres, then dilated
-// `gutter` texels into the empty ones around, so bilinear filtering at a chart's border never
-// reads an unbaked texel or another chart's (use no mipmaps: coarser levels would mix charts).
+// atlas. Seams: every texel whose centre lies in a triangle or within one texel (Chebyshev) of
+// it is baked from the nearest surface point of that triangle (the inside one wins), so bilinear
+// filtering anywhere in a chart reads only texels of its own chart, baked; `gutter` dilation
+// passes then fill the empty texels next to baked ones as a margin. Use no mipmaps: coarser
+// levels would mix charts.
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
@@ -19,7 +22,7 @@ namespace glint::gltf {
 
 struct AtlasParams {
   int size = 2048;  // texels per side
-  int gutter = 2;   // empty texels around each chart, filled by dilation
+  int gutter = 1;   // texels around each chart's bounding rectangle (>= 1)
 };
 
 struct AtlasLayout {
@@ -49,9 +52,9 @@ AtlasLayout layout_atlas(const std::vector<Eigen::Vector3f>& vertices,
 using SurfaceSampler = std::function<Eigen::Vector3f(const Eigen::Vector3f& point, int triangle)>;
 
 // The atlas image (3 channels, as the sampler returns them, 0 where no chart is): every texel
-// whose centre lies in a triangle gets sample(point under it); then `params.gutter` dilation
-// passes give each empty texel next to baked ones their mean (8-neighbourhood). Also fills
-// `layout.overlapping_texels`.
+// whose centre lies in a triangle, or within one texel of it, gets sample(nearest point of the
+// triangle); then `params.gutter` dilation passes give each empty texel next to baked ones their
+// mean (8-neighbourhood). Also fills `layout.overlapping_texels`.
 ImageF bake_atlas(AtlasLayout& layout, const std::vector<Eigen::Vector3f>& vertices,
                   const SurfaceSampler& sample, const AtlasParams& params = {});
 

@@ -37,7 +37,7 @@ TEST_F(ReconstructCli, WritesTheModelMaterialsLightsPicturesAndReport) {
             " --report " + path("report.json"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   for (const char* file :
-       {"mesh.ply", "materials.json", "lights.json", "materials-over-time.png",
+       {"mesh.ply", "materials.json", "lights.json", "scene.glb", "materials-over-time.png",
         "frames/000023-render.png", "frames/000023-albedo.png", "frames/000023-input.png"})
     EXPECT_TRUE(fs::exists(path("out") + "/" + file)) << file;
   const nlohmann::json report = io::read_json(path("report.json"));
@@ -58,6 +58,9 @@ TEST_F(ReconstructCli, WritesTheModelMaterialsLightsPicturesAndReport) {
             fusion::CudaIntegrator::available() ? "cuda" : "cpu");
   // The table is printed.
   EXPECT_NE(result.output.find("kd_ref"), std::string::npos);
+  // scene.glb: its counts in the report (the file itself: tests/gltf).
+  EXPECT_GT(report["scene_glb"]["triangles"].get<int>(), 0);
+  EXPECT_EQ(report["scene_glb"]["lights"], 2);  // the cubes scene's
 }
 
 // Four frames give no voxel the 5 observations an estimate needs: the run still succeeds, and
