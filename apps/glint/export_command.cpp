@@ -4,6 +4,7 @@
 
 #include "cli_support.h"
 #include "commands.h"
+#include "core/error.h"
 #include "core/log.h"
 #include "core/timer.h"
 #include "io/json_report.h"
@@ -38,11 +39,17 @@ gltf::ExportParams scene_export_params(const SceneExportOptions& options) {
 }
 
 nlohmann::json export_scene(const std::string& folder, const std::string& path,
-                            const SceneExportOptions& options) {
+                            const SceneExportOptions& options, bool optional) {
   const gltf::ExportParams params = scene_export_params(options);
   Stopwatch watch;
-  const gltf::Reconstruction scene = gltf::read_reconstruction(folder);
-  const gltf::ExportStats stats = gltf::write_scene_glb(scene, params, path);
+  gltf::ExportStats stats;
+  try {
+    stats = gltf::write_scene_glb(gltf::read_reconstruction(folder), params, path);
+  } catch (const Error& e) {
+    if (!optional) throw;
+    log().warn("scene.glb not written: {}", e.what());
+    return nullptr;
+  }
   const double seconds = watch.elapsed_s();
   const auto bytes = std::filesystem::file_size(path);
   log().info(
@@ -88,9 +95,11 @@ void register_export_command(CLI::App& app) {
       "  glint export out/bunnies -o bunnies.glb\n"
       "  glint export out/kitchen -o kitchen.glb --up -y --mesh-triangles 100000\n"
       "  glint export out/office -o office-full.glb --mesh-triangles 0 --texture-size 4096\n"
-      "Check a file: node web/node_modules/gltf-validator (see docs/reflectance.md, Export).");
+      "Check a file: node scripts/validate-glb.cjs X.glb (the Khronos glTF-Validator; see\n"
+      "docs/reflectance.md, Export).");
   command->callback([options] {
-    nlohmann::json report = export_scene(options->folder, options->output, options->scene);
+    nlohmann::json report =
+        export_scene(options->folder, options->output, options->scene, /*optional=*/false);
     if (options->report.empty()) return;
     report["command"] = command_line();
     report["input"] = options->folder;

@@ -180,7 +180,8 @@ void run_reconstruct(ReconstructOptions options) {
   if (options.glb) {
     // From the files just written, as `glint export OUT` would: both give the same scene.glb.
     watch.restart();
-    glb_report = export_scene(staging, (fs::path(staging) / "scene.glb").string(), options.scene);
+    glb_report = export_scene(staging, (fs::path(staging) / "scene.glb").string(), options.scene,
+                              /*optional=*/true);
     command_timings.add("glb", watch.elapsed_ms());
   }
   if (has_truth && !evaluation.series().empty()) {

@@ -33,8 +33,8 @@ class ReconstructCli : public CliTest {
 TEST_F(ReconstructCli, WritesTheModelMaterialsLightsPicturesAndReport) {
   const CommandResult result =
       glint("reconstruct " + path("seq") + " --gt-lights --gt-poses --gt-segmentation --model " +
-            path("model.json") + " --eval-every 4 --obs-voxel 0.02 -o " + path("out") +
-            " --report " + path("report.json"));
+            path("model.json") + " --eval-every 4 --obs-voxel 0.02 --mesh-triangles 20000 " +
+            "--texture-size 256 -o " + path("out") + " --report " + path("report.json"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   for (const char* file :
        {"mesh.ply", "materials.json", "lights.json", "scene.glb", "materials-over-time.png",
@@ -68,8 +68,8 @@ TEST_F(ReconstructCli, WritesTheModelMaterialsLightsPicturesAndReport) {
 TEST_F(ReconstructCli, SaysWhichSegmentsGotNoMaterial) {
   const CommandResult result =
       glint("reconstruct " + path("seq") + " --gt-lights --gt-poses --gt-segmentation --model " +
-            path("model.json") + " --eval-every 0 --frames 4 -o " + path("short") + " --report " +
-            path("short.json"));
+            path("model.json") + " --eval-every 0 --frames 4 --no-glb -o " + path("short") +
+            " --report " + path("short.json"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const nlohmann::json coverage = io::read_json(path("short.json"))["material_coverage"];
   EXPECT_GE(coverage["segments"].get<int>(), 1);
@@ -85,8 +85,8 @@ TEST_F(ReconstructCli, OwnSegmentationRuns) {
   reflectance::HemiCnn(reflectance_input).save(path("reflectance-model.json"));
   const CommandResult result = glint(
       "reconstruct " + path("seq") + " --gt-lights --model " + path("reflectance-model.json") +
-      " --gt-poses --eval-every 0 --segment-noise 1 --albedo-keep-clipped -o " + path("own") +
-      " --report " + path("own.json"));
+      " --gt-poses --eval-every 0 --segment-noise 1 --albedo-keep-clipped --no-glb -o " +
+      path("own") + " --report " + path("own.json"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const nlohmann::json materials = io::read_json(path("own") + "/materials.json");
   EXPECT_GE(materials["segments"].size(), 1u);
@@ -110,8 +110,9 @@ TEST_F(ReconstructCli, TracksTheCameraAgainstAHalfResolutionModel) {
   EXPECT_LT(fused["ate"]["rmse_m"].get<double>(), 0.01);
 
   result = glint("reconstruct " + path("path") + " --frames 24 --gt-lights --gt-segmentation " +
-                 "--model " + path("model.json") + " --track-model-halvings 1 --eval-every 0 -o " +
-                 path("tracked") + " --report " + path("tracked.json"));
+                 "--model " + path("model.json") +
+                 " --track-model-halvings 1 --eval-every 0 --no-glb -o " + path("tracked") +
+                 " --report " + path("tracked.json"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const nlohmann::json report = io::read_json(path("tracked.json"));
   EXPECT_EQ(report["parameters"]["track_model_halvings"], 1);
@@ -183,6 +184,11 @@ TEST_F(ReconstructCli, BadInputsFailClearly) {
                  path("mine") + "/notes.txt/report.json");
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("is a file, not a folder"), std::string::npos) << result.output;
+  EXPECT_FALSE(fs::exists(path("y")));
+  // An unknown --up axis (scene.glb's) fails before the run.
+  result = glint("reconstruct " + path("seq") + " --gt-lights --up sideways -o " + path("y"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("--up"), std::string::npos) << result.output;
   EXPECT_FALSE(fs::exists(path("y")));
   // --gt-poses with a frame the pose file leaves out: named before the run starts.
   fs::copy(path("seq"), path("gaps"), fs::copy_options::recursive);
