@@ -10,6 +10,7 @@ packages=(
   # of the reference BLAS makes the denoisers' U-Net several times faster.
   libtorch-dev libopenblas0-openmp
   libopencv-dev
+  libpng-dev
   libembree-dev libtinyobjloader-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev

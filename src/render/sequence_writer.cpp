@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/timer.h"
@@ -151,6 +152,7 @@ SequenceStats write_sequence(const Scene& scene, const std::string& out_dir,
   io::write_tum_trajectory((staging / "groundtruth.txt").string(), groundtruth);
   write_scene_json((staging / "scene.json").string(), scene);
 
+  throw_if_interrupted();
   fs::remove_all(out_dir, error);
   if (!error) fs::rename(staging, out_dir, error);
   if (error)
