@@ -21,9 +21,4 @@ class Error : public std::runtime_error {
   std::string reason_;
 };
 
-// Throws glint::Error saying that `what` (e.g. "a 20000x20000 image of 3 channels") could not be
-// allocated and how many bytes it needed: the message a bare std::bad_alloc lacks.
-// (bytes is a double: the sizes that fail may not fit size_t.)
-[[noreturn]] void throw_out_of_memory(const std::string& what, double bytes);
-
 }  // namespace glint

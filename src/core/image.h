@@ -3,11 +3,7 @@
 // three). Planar storage, channel-major (one contiguous plane per channel, rows top to
 // bottom): per-channel filters stream through memory and the layout is libtorch's CHW.
 #include <cstddef>
-#include <exception>
-#include <string>
 #include <vector>
-
-#include "core/error.h"
 
 namespace glint {
 
@@ -19,7 +15,7 @@ class Image {
       : width_(width),
         height_(height),
         channels_(channels),
-        data_(allocate(width, height, channels, fill)) {}
+        data_(static_cast<std::size_t>(width) * height * channels, fill) {}
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -47,16 +43,6 @@ class Image {
   const std::vector<T>& values() const { return data_; }
 
  private:
-  static std::vector<T> allocate(int width, int height, int channels, T fill) {
-    const std::size_t count = static_cast<std::size_t>(width) * height * channels;
-    try {
-      return std::vector<T>(count, fill);
-    } catch (const std::exception&) {  // std::bad_alloc, or std::length_error beyond max_size()
-      throw_out_of_memory("a " + std::to_string(width) + "x" + std::to_string(height) +
-                              " image of " + std::to_string(channels) + " channels",
-                          double(width) * height * channels * sizeof(T));
-    }
-  }
   std::size_t index(int x, int y, int c) const {
     return (static_cast<std::size_t>(c) * height_ + y) * width_ + x;
   }

@@ -55,6 +55,12 @@ void check_intrinsics(const Intrinsics& k, const std::string& file, const std::s
   check(k.cy, 0, k.height, false, "cy");
 }
 
+void throw_out_of_memory(const std::string& what, double bytes) {
+  throw Error("", what,
+              fmt::format("out of memory: it needs {:.0f} MiB, more than this machine could give",
+                          std::ceil(bytes / (1 << 20))));
+}
+
 void check_integer(double value, double lowest, double highest, const std::string& file,
                    const std::string& element) {
   if (!(value >= lowest && value <= highest && value == std::floor(value)))

@@ -36,6 +36,11 @@ void check_image_size(std::int64_t width, std::int64_t height, const std::string
 // the intrinsics in the file ("camera.intrinsics"; may be empty).
 void check_intrinsics(const Intrinsics& intrinsics, const std::string& file,
                       const std::string& element);
+// Throws glint::Error saying that `what` (e.g. "a cloud of 10^12 points") could not be
+// allocated and how many bytes it needed: the message a bare std::bad_alloc lacks. (bytes is a
+// double: the sizes that fail may not fit size_t.)
+[[noreturn]] void throw_out_of_memory(const std::string& what, double bytes);
+
 // Throws unless `value` is an integer in [lowest, highest].
 void check_integer(double value, double lowest, double highest, const std::string& file,
                    const std::string& element);

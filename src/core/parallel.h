@@ -7,18 +7,13 @@
 #include <cstddef>
 #include <memory>
 
-#include "core/interrupt.h"
-
 namespace glint {
 
 // Calls body(i) for every i in [0, n), in parallel. body must be safe to call concurrently.
-// Both loops check for SIGINT / SIGTERM once per chunk (core/interrupt.h) and then throw
-// glint::Interrupted, so every long job stops soon after a Ctrl-C.
 template <class Body>
 void parallel_for(std::size_t n, Body&& body) {
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n),
                     [&](const tbb::blocked_range<std::size_t>& range) {
-                      throw_if_interrupted();
                       for (std::size_t i = range.begin(); i != range.end(); ++i) body(i);
                     });
 }
@@ -27,11 +22,9 @@ void parallel_for(std::size_t n, Body&& body) {
 // use it when a chunk shares scratch memory or set-up work.
 template <class Body>
 void parallel_for_chunks(std::size_t n, std::size_t grain, Body&& body) {
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, grain),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      throw_if_interrupted();
-                      body(range.begin(), range.end());
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, n, grain),
+      [&](const tbb::blocked_range<std::size_t>& range) { body(range.begin(), range.end()); });
 }
 
 // Limits TBB to `threads` worker threads for the lifetime of the returned object (0 = all).

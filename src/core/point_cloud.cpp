@@ -5,10 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <new>
+#include <exception>
 #include <string>
 
 #include "core/error.h"
+#include "core/limits.h"
 
 namespace glint {
 
@@ -25,8 +26,9 @@ void PointCloud::resize(std::size_t n) {
     x.resize(n);
     y.resize(n);
     z.resize(n);
-  } catch (const std::bad_alloc&) {
-    throw_out_of_memory("a cloud of " + std::to_string(n) + " points", 3.0 * n * sizeof(float));
+  } catch (const std::exception&) {  // std::bad_alloc, or std::length_error beyond max_size()
+    limits::throw_out_of_memory("a cloud of " + std::to_string(n) + " points",
+                                3.0 * double(n) * sizeof(float));
   }
   for (auto& attribute : attributes_) {
     std::visit([n](auto& values) { values.resize(n); }, attribute.values);

@@ -3,11 +3,15 @@
 #include <fmt/format.h>
 #include <png.h>
 
+#include <algorithm>
 #include <csetjmp>
 #include <cstdlib>
 #include <cstring>
+#include <iostream>
+#include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
+#include <sstream>
 
 #include "core/error.h"
 #include "core/limits.h"
@@ -191,7 +195,7 @@ cv::Mat decode_png(const std::string& path, std::string_view bytes, int flags) {
   structs.png =
       png_create_read_struct(PNG_LIBPNG_VER_STRING, &source, png_on_error, png_on_warning);
   if (structs.png) structs.info = png_create_info_struct(structs.png);
-  if (!structs.png || !structs.info) throw_out_of_memory("the PNG decoder's state", 0);
+  if (!structs.png || !structs.info) limits::throw_out_of_memory("the PNG decoder's state", 0);
   png_set_read_fn(structs.png, &source, png_read_from_memory);
   png_uint_32 width = 0, height = 0;
   int bit_depth = 0, colour_type = 0;
@@ -217,8 +221,9 @@ cv::Mat decode_png(const std::string& path, std::string_view bytes, int flags) {
   try {
     image.create(static_cast<int>(height), static_cast<int>(width), CV_MAKETYPE(depth, channels));
   } catch (const cv::Exception&) {
-    throw_out_of_memory(fmt::format("a {}x{} image of {} channels", width, height, channels),
-                        double(width) * height * channels * (depth == CV_8U ? 1 : 2));
+    limits::throw_out_of_memory(
+        fmt::format("a {}x{} image of {} channels", width, height, channels),
+        double(width) * height * channels * (depth == CV_8U ? 1 : 2));
   }
   std::vector<png_bytep> rows(height);
   for (png_uint_32 y = 0; y < height; ++y) rows[y] = image.ptr(static_cast<int>(y));
@@ -226,6 +231,37 @@ cv::Mat decode_png(const std::string& path, std::string_view bytes, int flags) {
     throw Error(path, "", "not a readable PNG: " + source.error);
   return image;
 }
+
+// OpenCV prints "imread_(...): can't read data: <reason>" on std::cerr when a decoder throws,
+// and returns an empty image. While one lives, std::cerr writes into text() instead, so the
+// reason becomes part of glint's line. One at a time (std::cerr is global); PNG, the format of
+// every RGB-D frame, does not come here.
+class OpenCvMessages {
+ public:
+  OpenCvMessages() : lock_(mutex()), previous_(std::cerr.rdbuf(captured_.rdbuf())) {}
+  ~OpenCvMessages() { std::cerr.rdbuf(previous_); }
+  OpenCvMessages(const OpenCvMessages&) = delete;
+  OpenCvMessages& operator=(const OpenCvMessages&) = delete;
+
+  // The reason OpenCV gave, one line, or "" when it printed nothing.
+  std::string reason() const {
+    std::string text = captured_.str();
+    const std::size_t colon = text.find("can't read data: ");
+    if (colon != std::string::npos) text = text.substr(colon + 17);
+    while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+    std::replace(text.begin(), text.end(), '\n', ' ');
+    return text;
+  }
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex instance;
+    return instance;
+  }
+  std::lock_guard<std::mutex> lock_;
+  std::ostringstream captured_;
+  std::streambuf* previous_;
+};
 
 }  // namespace
 
@@ -265,6 +301,7 @@ cv::Mat decode_image_file(const std::string& path, int flags) {
   require_complete_image(path, bytes);
   if (std::string_view(bytes).starts_with(kPngSignature)) return decode_png(path, bytes, flags);
   cv::Mat image;
+  OpenCvMessages messages;
   try {
     if (is_hdr(bytes)) {
       // OpenCV decodes Radiance HDR from memory through a temporary copy of the file, which it
@@ -278,8 +315,12 @@ cv::Mat decode_image_file(const std::string& path, int flags) {
   } catch (const cv::Exception& e) {
     throw Error(path, "", "cannot decode the image: " + e.err);
   }
-  if (image.empty())
-    throw Error(path, "", "not a readable image (unknown format, corrupt or truncated)");
+  if (image.empty()) {
+    const std::string reason = messages.reason();
+    throw Error(path, "",
+                reason.empty() ? "not a readable image (unknown format, corrupt or truncated)"
+                               : "not a readable image: " + reason);
+  }
   return image;
 }
 

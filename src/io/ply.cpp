@@ -6,11 +6,13 @@
 #include <bit>
 #include <cctype>
 #include <cmath>
+#include <new>
 #include <optional>
 #include <string_view>
 #include <vector>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "io/atomic_file.h"
 #include "io/codec.h"
 #include "io/file_bytes.h"
@@ -419,7 +421,7 @@ PointCloud read_vertices(const std::string& path, Body& body, const Element& ver
     for (std::vector<double>* axis : {&positions.x, &positions.y, &positions.z})
       axis->resize(allocated);
   } catch (const std::bad_alloc&) {
-    throw_out_of_memory(fmt::format("the positions of {} vertices", allocated), 24.0 * allocated);
+    limits::throw_out_of_memory(fmt::format("the positions of {} vertices", allocated), 24.0 * allocated);
   }
   std::vector<NamedAttribute> attributes;
   const std::vector<Slot> slots = plan_slots(vertex, allocated, positions, attributes);

@@ -114,6 +114,7 @@ SequenceStats write_sequence(const Scene& scene, const std::string& out_dir,
   std::optional<ProgressBar> progress;
   if (options.progress) progress.emplace("render", static_cast<std::size_t>(count));
   for (int frame = first; frame < first + count; ++frame) {
+    throw_if_interrupted();  // also without a progress bar
     Stopwatch frame_watch;
     const Pose& pose = scene.trajectory[frame];
     const FrameBuffers buffers = renderer.render(pose, frame);

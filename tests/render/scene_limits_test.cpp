@@ -26,7 +26,7 @@ TEST(SceneLimits, OutOfRangeNumbersNameTheFieldAndTheRange) {
   const Case cases[] = {
       // The Embree assertion: a camera at 1.8e18 m.
       {R"({"objects": [], "trajectory": [[1.8e18, 0, 0, 0, 0, 0, 1]]})", "trajectory[0] position",
-       "outside the world extent [-1e+05, 1e+05] m"},
+       "outside the world extent [-100000, 100000] m"},
       {R"({"objects": [{"shape": "box", "transform": {"position": [0, 1e30, 0]}}],
            "trajectory": [[0, 0, 3, 0, 0, 0, 1]]})",
        "objects[0].transform.position", "world extent"},
@@ -103,7 +103,7 @@ TEST_F(CliTest, RenderRefusesACameraOutsideTheWorldBeforeAnyRay) {
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_EQ(run.output, "glint: error: " + path("scene.json") +
                             ": trajectory[0] position: coordinate 1.8e+18 is outside the world "
-                            "extent [-1e+05, 1e+05] m\n");
+                            "extent [-100000, 100000] m\n");
   for (const auto& entry : std::filesystem::directory_iterator(folder_))
     EXPECT_EQ(entry.path().filename().string().find("seq"), std::string::npos) << entry.path();
 }
