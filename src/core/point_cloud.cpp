@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <exception>
+#include <limits>
 #include <string>
 
 #include "core/error.h"
@@ -124,7 +124,9 @@ void set_positions(PointCloud& cloud, const double* x, const double* y, const do
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
   if (n > 0) {
     const Eigen::Vector3d centre = 0.5 * lower + 0.5 * upper;  // halves first: no overflow
-    if (centre.cwiseAbs().maxCoeff() > (upper - lower).maxCoeff()) origin = centre.array().round();
+    const double distance = centre.cwiseAbs().maxCoeff();
+    if (distance > kRecentreBeyond && distance > (upper - lower).maxCoeff())
+      origin = centre.array().round();
   }
   cloud.resize(n);
   cloud.origin = origin;
@@ -132,11 +134,11 @@ void set_positions(PointCloud& cloud, const double* x, const double* y, const do
   for (std::size_t i = 0; i < n; ++i) {
     for (int a = 0; a < 3; ++a) {
       const double relative = axes[a][i] - origin[a];
-      if (!(std::abs(relative) <= kMaxCloudCoordinate))
+      if (!std::isfinite(static_cast<float>(relative)))  // rounds to at most FLT_MAX
         throw Error(file, "vertex " + std::to_string(i),
-                    fmt::format("coordinate {} is {:g} from the cloud's origin {}; the allowed "
-                                "range is +-{:g} around it (split or rescale the cloud)",
-                                axes[a][i], relative, origin[a], kMaxCloudCoordinate));
+                    fmt::format("coordinate {} is {:g} from the cloud's origin {}: outside the "
+                                "float range",
+                                axes[a][i], relative, origin[a]));
       out[a][i] = static_cast<float>(relative);
     }
   }

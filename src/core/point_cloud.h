@@ -66,16 +66,20 @@ class PointCloud {
   std::vector<NamedAttribute> attributes_;
 };
 
-// Largest |coordinate - origin| a cloud may have, in its own unit (1e9): beyond it squared
-// distances and covariance sums overflow float (a coordinate of 1e37 gave NaN probabilities).
+// Largest |coordinate - origin| edge features accept, in the cloud's unit (1e9): beyond it
+// squared distances and covariance sums overflow float (a coordinate of 1e37 gave NaN
+// probabilities). Checked by edges::compute_features, not by the readers.
 inline constexpr double kMaxCloudCoordinate = 1e9;
+// A cloud whose bounding-box centre is farther from 0 than this (in its unit) and than its own
+// size is re-centred on read: float keeps 1 mm steps up to about 1e4.
+inline constexpr double kRecentreBeyond = 1e4;
 
-// Makes `cloud` hold the n points (x[i], y[i], z[i]) given in double: when the cloud lies
-// farther from 0 than its own size, it is re-centred on the integer point nearest its bounding
-// box's centre (float coordinates far from 0 then round-trip exactly); otherwise origin = 0 and
-// positions are as given. Attributes are untouched (the cloud must hold n points or none). Throws
-// glint::Error(file, "vertex i", ...) for a non-finite coordinate or one farther than
-// kMaxCloudCoordinate from the origin.
+// Makes `cloud` hold the n points (x[i], y[i], z[i]) given in double: when the cloud's centre
+// lies farther from 0 than kRecentreBeyond and than the cloud's own size, it is re-centred on
+// the integer point nearest its bounding box's centre (float coordinates far from 0 then
+// round-trip exactly); otherwise origin = 0 and positions are as given. Attributes are
+// untouched (the cloud must hold n points or none). Throws glint::Error(file, "vertex i", ...)
+// for a non-finite coordinate or one that does not fit a float relative to the origin.
 void set_positions(PointCloud& cloud, const double* x, const double* y, const double* z,
                    std::size_t n, const std::string& file);
 

@@ -3,6 +3,7 @@
 // output left behind).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -124,8 +125,12 @@ TEST_F(DenoiseCliTest, ImageHeadersAreCheckedAndLibpngSpeaksInGlintsLine) {
   const CommandResult damaged =
       glint("denoise noise-map " + path("damaged.png") + " -o " + path("m.png"));
   EXPECT_EQ(damaged.exit_code, 1);
-  EXPECT_EQ(damaged.output,
-            "glint: error: " + path("damaged.png") + ": not a readable PNG: IDAT: CRC error\n");
+  // One line with libpng's reason (zlib meets the damage before the chunk's CRC is checked).
+  EXPECT_EQ(damaged.output.rfind(
+                "glint: error: " + path("damaged.png") + ": not a readable PNG: IDAT: ", 0),
+            0u)
+      << damaged.output;
+  EXPECT_EQ(std::count(damaged.output.begin(), damaged.output.end(), '\n'), 1);
 }
 
 }  // namespace

@@ -8,9 +8,11 @@
 #include <fstream>
 
 #include "edges/classifier.h"
+#include "edges/features.h"
 #include "edges/model.h"
 #include "edges/synth.h"
 #include "io/ply.h"
+#include "support/error_of.h"
 
 namespace glint::edges {
 namespace {
@@ -49,6 +51,18 @@ TEST(FarCloud, LabelsAtA1e7OffsetAreThoseAtTheOrigin) {
     changed += at_origin.labels[i] != far_away.labels[i];
   // The positions differ at most by float rounding of a whole-metre shift.
   EXPECT_LE(changed, near.size() / 1000) << changed << " of " << near.size() << " labels changed";
+}
+
+// Squared distances of a coordinate of 1e37 overflow float: NaN probabilities, before.
+TEST(FarCloud, CoordinateBeyondTheFeatureRangeIsAnError) {
+  SynthParams params;
+  params.min_points = params.max_points = 4000;
+  PointCloud cloud = synthesize_cloud(params, 1).cloud;
+  cloud.z[5] = 1e37f;
+  const Error error = glint::test::error_of([&] { compute_features(cloud); });
+  EXPECT_EQ(error.element(), "point 5");
+  EXPECT_NE(error.reason().find("is more than 1e+09 from the cloud's origin"), std::string::npos)
+      << error.what();
 }
 
 }  // namespace

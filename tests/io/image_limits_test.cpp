@@ -54,13 +54,14 @@ TEST(ImageLimits, CorruptPngIsOneErrorWithLibpngsReasonAndNothingOnStderr) {
   write_image(path, ImageF(32, 32, 3, 0.25f));
   std::string bytes = read_text(path);
   const std::size_t data = bytes.find("IDAT") + 8;
-  bytes[data] = char(bytes[data] ^ 0x55);  // its CRC no longer matches
+  bytes[data] = char(bytes[data] ^ 0x55);  // damaged compressed data
   write_text(path, bytes);
   ::testing::internal::CaptureStderr();
   const Error error = error_of([&] { read_image(path); });
   EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
   EXPECT_EQ(error.file(), path);
-  EXPECT_THAT(error.reason(), HasSubstr("not a readable PNG: IDAT: CRC error"));
+  // zlib meets the damage before the chunk's CRC is checked: libpng's reason, whichever it is.
+  EXPECT_THAT(error.reason(), ::testing::StartsWith("not a readable PNG: IDAT: "));
 }
 
 TEST(ImageLimits, PngSamplesAreThoseOfOpenCv) {

@@ -250,11 +250,11 @@ TEST(Ply, MalformedAsciiValuesNameTheVertex) {
   expect_ply_error(header + "0 0 0 1\n1 nan 1 0\n", "vertex 1", "non-finite coordinate");
   expect_ply_error(header + "0 0 0 1\n1 1 1e39 0\n", "line 10 (vertex 1)",
                    "1e39 does not fit the property type float");
-  // 1e300 from its neighbour: no origin brings both within float's reach.
+  // 1e300 from its neighbour: no origin brings both within float's range.
   expect_ply_error(
       "ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\n"
       "property double y\nproperty double z\nend_header\n0 0 0\n1 1e300 1\n",
-      "vertex 1", "is 1e+300 from the cloud's origin 0; the allowed range is +-1e+09");
+      "vertex 1", "is 1e+300 from the cloud's origin 0: outside the float range");
 }
 
 // One record per line: a line with a value too many or too few is named, never read on into
@@ -272,10 +272,11 @@ TEST(Ply, AsciiLinesWithExtraOrMissingValuesNameTheLine) {
       "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int vertex_indices\n"
       "element vertex 1\n" +
           kXyz + "end_header\n3 0 0\n0 0 0\n",
-      "line 9 (face 0)", "the line ends early");
+      "line 10 (face 0)", "the line ends early");
   // Blank lines between records are fine.
-  test::write_text(scratch("blank.ply"), header + "0 0 0 1\n\n1 1 1 0\n  \n2 2 2 2\n");
-  const PointCloud cloud = read_ply(scratch("blank.ply"));
+  const std::string blank = scratch("blank.ply");
+  test::write_text(blank, header + "0 0 0 1\n\n1 1 1 0\n  \n2 2 2 2\n");
+  const PointCloud cloud = read_ply(blank);
   ASSERT_EQ(cloud.size(), 3u);
   EXPECT_EQ(cloud.z[2], 2.0f);
 }
