@@ -183,7 +183,7 @@ void bind_io(py::module_ m) {
 
 Returns:
     (xyz, fields): xyz (N, 3) float32 positions (interleaved from glint's per-axis arrays;
-    float64 for a cloud farther from 0 than its own size, which glint re-centres on read);
+    float64 for a cloud whose centre lies beyond 1e4 from 0, which glint re-centres on read);
     fields: dict of the per-point properties by name (e.g. 'scalar_label', 'red'), each a
     1-D array of the stored type (copied).
 
