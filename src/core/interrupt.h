@@ -6,9 +6,9 @@
 // the render loop at every frame; the commits of AtomicFile, LAS files and staged output
 // folders before they rename) and throw Interrupted, whose unwinding removes every temporary
 // output (AtomicFile, ".partial-<pid>" folders, temporary tile folders are all RAII). main()
-// turns it into exit status 128 + signal (130 for SIGINT, 143 for SIGTERM). A second signal ends the process at once (the default
-// action). Without install_interrupt_handlers() (the library in another program, Python) the flag
-// is never set and nothing changes.
+// turns it into exit status 128 + signal (130 for SIGINT, 143 for SIGTERM). A second signal ends
+// the process at once (the default action). Without install_interrupt_handlers() (the library in
+// another program, Python) the flag is never set and nothing changes.
 #include <exception>
 
 namespace glint {
