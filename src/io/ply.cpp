@@ -421,7 +421,8 @@ PointCloud read_vertices(const std::string& path, Body& body, const Element& ver
     for (std::vector<double>* axis : {&positions.x, &positions.y, &positions.z})
       axis->resize(allocated);
   } catch (const std::bad_alloc&) {
-    limits::throw_out_of_memory(fmt::format("the positions of {} vertices", allocated), 24.0 * allocated);
+    limits::throw_out_of_memory(fmt::format("the positions of {} vertices", allocated),
+                                24.0 * allocated);
   }
   std::vector<NamedAttribute> attributes;
   const std::vector<Slot> slots = plan_slots(vertex, allocated, positions, attributes);
