@@ -41,7 +41,7 @@ set(CPACK_DEBIAN_RUNTIME_PACKAGE_RECOMMENDS "libopenblas0-openmp")
 # glintConfig.cmake's find_dependency() calls, and the runtime package for the models.
 set(glint_dev_depends
     "glint (= ${PROJECT_VERSION}), libeigen3-dev, libnanoflann-dev, libtbb-dev, nlohmann-json3-dev,"
-    " libfmt-dev, libspdlog-dev, libopencv-dev, libembree-dev, libtinyobjloader-dev,"
+    " libfmt-dev, libspdlog-dev, libopencv-dev, libpng-dev, libembree-dev, libtinyobjloader-dev,"
     " libmeshoptimizer-dev,"
     " libocct-foundation-dev, libocct-modeling-data-dev, libocct-modeling-algorithms-dev,"
     " libocct-data-exchange-dev")

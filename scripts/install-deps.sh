@@ -12,6 +12,7 @@ packages=(
   # of the reference BLAS makes the denoisers' U-Net several times faster.
   libtorch-dev libopenblas0-openmp
   libopencv-dev
+  libpng-dev
   libembree-dev libtinyobjloader-dev
   # glTF scene export: mesh simplification.
   libmeshoptimizer-dev

@@ -154,7 +154,20 @@ void run_classify(const ClassifyOptions& options) {
     throw Error(options.input, e.element(), e.reason());
   }
   edges::attach_classification(cloud, result);
+  // The picture is made before any file is written, and a failure writing it takes the PLY
+  // back: the command leaves both outputs or neither.
+  std::vector<std::uint8_t> preview;
+  if (!options.png.empty()) preview = encode_point_preview(options.png, cloud);
   io::write_ply(options.output, cloud);
+  if (!options.png.empty()) {
+    try {
+      write_png_bytes(options.png, preview);
+    } catch (...) {
+      std::error_code ignored;
+      std::filesystem::remove(options.output, ignored);
+      throw;
+    }
+  }
 
   std::size_t counts[3] = {0, 0, 0};
   for (const auto label : result.labels) ++counts[std::min<int>(label, 2)];
@@ -165,10 +178,7 @@ void run_classify(const ClassifyOptions& options) {
       options.input, cloud.size(), counts[0], counts[1], counts[2], total_s, result.features_s,
       result.inference_s, double(cloud.size()) / total_s, options.output);
 
-  if (!options.png.empty()) {
-    write_point_preview(options.png, cloud);
-    fmt::print("picture -> {}\n", options.png);
-  }
+  if (!options.png.empty()) fmt::print("picture -> {}\n", options.png);
   if (!options.report.empty()) {
     io::write_json(
         options.report,
@@ -229,7 +239,8 @@ void register_edges_classify(CLI::App& edges) {
   command->add_option("--tile-points", options->tile_points,
                       "LAS input: at most this many points per tile, halo included (default: "
                       "what --memory-limit allows)");
-  command->add_option("--png", options->png, "Also draw the labelled cloud to this PNG");
+  command->add_option("--png", options->png, "Also draw the labelled cloud to this PNG")
+      ->check(kOutputFile);
   command->add_option("--report", options->report, "Write a JSON report (counts, timings)")
       ->check(kOutputFile);
   command->callback([options] { run_classify(*options); });

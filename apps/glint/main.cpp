@@ -5,12 +5,14 @@
 #include <malloc.h>
 #endif
 #include <exception>
+#include <new>
 
 #include "cli_support.h"
 #include "commands.h"
 #include "core/build_info.h"
 #include "core/distributed.h"
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "core/log.h"
 #include "core/parallel.h"
 #include "core/progress.h"
@@ -67,11 +69,22 @@ int main(int argc, char** argv) {
     thread_limit = glint::limit_threads(common.threads);
   });
 
+  // Ctrl-C and SIGTERM stop a long job at its next check and remove its unfinished outputs.
+  glint::install_interrupt_handlers();
   try {
     glint::refuse_mpi_launch_without_mpi();
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const glint::Interrupted& e) {
+    std::fprintf(stderr, "glint: %s\n", e.what());
+    return e.exit_status();
+  } catch (const std::bad_alloc&) {
+    // Allocations of images and clouds name themselves (glint::Error); this is any other one.
+    std::fprintf(stderr,
+                 "glint: error: out of memory (an allocation failed; try a smaller input, fewer "
+                 "--threads, or a tiled mode where the command has one)\n");
+    return 1;
   } catch (const glint::Error& e) {
     std::fprintf(stderr, "glint: error: %s\n", e.what());
     return 1;

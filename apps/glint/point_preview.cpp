@@ -2,17 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <limits>
 #include <numbers>
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
+#include "io/atomic_file.h"
 
 namespace glint::app {
 
-void write_point_preview(const std::string& path, const PointCloud& cloud,
-                         const PreviewParams& params) {
+std::vector<std::uint8_t> encode_point_preview(const std::string& path, const PointCloud& cloud,
+                                               const PreviewParams& params) {
   const std::size_t n = cloud.size();
   if (n == 0) throw Error(path, "", "nothing to draw: the cloud is empty");
   const auto* red = cloud.get<std::uint8_t>("red");
@@ -75,12 +75,21 @@ void write_point_preview(const std::string& path, const PointCloud& cloud,
       }
     }
   }
-  const std::string temporary = path + ".partial.png";
-  if (!cv::imwrite(temporary, image)) {
-    std::filesystem::remove(temporary);
-    throw Error(path, "", "could not write the PNG");
-  }
-  std::filesystem::rename(temporary, path);
+  std::vector<std::uint8_t> png;
+  if (!cv::imencode(".png", image, png)) throw Error(path, "", "could not encode the PNG");
+  return png;
+}
+
+void write_png_bytes(const std::string& path, const std::vector<std::uint8_t>& png) {
+  io::AtomicFile file(path);
+  file.stream().write(reinterpret_cast<const char*>(png.data()),
+                      static_cast<std::streamsize>(png.size()));
+  file.commit();
+}
+
+void write_point_preview(const std::string& path, const PointCloud& cloud,
+                         const PreviewParams& params) {
+  write_png_bytes(path, encode_point_preview(path, cloud, params));
 }
 
 }  // namespace glint::app

@@ -7,6 +7,7 @@
 
 #include "cli_support.h"
 #include "commands.h"
+#include "core/limits.h"
 #include "core/log.h"
 #include "io/json_report.h"
 #include "render/scene_json.h"
@@ -34,6 +35,7 @@ void run_render(const RenderOptions& options) {
     const int width = options.width.value_or(int(std::lround(*options.height / aspect)));
     const int height = options.height.value_or(int(std::lround(*options.width * aspect)));
     intrinsics = intrinsics.resized(width, height);
+    limits::check_intrinsics(intrinsics, "--width/--height", "");
   }
   if (options.exposure) scene.camera.exposure = *options.exposure;
   if (options.no_shadows) scene.shadows = false;
@@ -97,12 +99,12 @@ void register_render_command(CLI::App& app) {
       ->add_option("--bounces", options->bounces,
                    "Indirect bounces to path trace (overrides scene.json's \"bounces\", default "
                    "0 = direct light only, the reflectance pipeline's image model)")
-      ->check(kNonNegative);
+      ->check(CLI::Range(0, limits::kMaxBounces));
   command
       ->add_option("--indirect-samples", options->indirect_samples,
                    "Paths per pixel for the indirect light (overrides scene.json, default 32); "
                    "its noise falls as 1/sqrt(samples), time grows linearly")
-      ->check(kPositive);
+      ->check(CLI::Range(1, limits::kMaxSamplesPerPixel));
   command->add_flag(
       "--no-gt", [options](std::int64_t) { options->sequence.ground_truth = false; },
       "Do not write gt/");

@@ -27,12 +27,18 @@ py::tuple read_point_cloud(const py::object& path_arg) {
     cloud = io::read_point_cloud(path);
   }
   const std::size_t n = cloud.size();
-  std::vector<float> xyz(3 * n);
-  for (std::size_t i = 0; i < n; ++i) {
-    xyz[3 * i] = cloud.x[i];
-    xyz[3 * i + 1] = cloud.y[i];
-    xyz[3 * i + 2] = cloud.z[i];
-  }
+  // A cloud the reader re-centred (far from 0) comes back in float64 with its own coordinates.
+  const auto interleave = [&](auto zero) {
+    using T = decltype(zero);
+    std::vector<T> xyz(3 * n);
+    for (std::size_t i = 0; i < n; ++i) {
+      xyz[3 * i] = T(cloud.origin.x() + T(cloud.x[i]));
+      xyz[3 * i + 1] = T(cloud.origin.y() + T(cloud.y[i]));
+      xyz[3 * i + 2] = T(cloud.origin.z() + T(cloud.z[i]));
+    }
+    return array_from_vector(std::move(xyz), {py::ssize_t(n), 3});
+  };
+  py::array positions = cloud.origin.isZero() ? interleave(0.0f) : interleave(0.0);
   py::dict fields;
   // Attributes leave the cloud one by one, moved into their arrays.
   std::vector<std::string> names;
@@ -43,7 +49,7 @@ py::tuple read_point_cloud(const py::object& path_arg) {
         std::visit([](auto& values) { return array_from_vector(std::move(values)); }, column);
     cloud.remove(name);
   }
-  return py::make_tuple(array_from_vector(std::move(xyz), {py::ssize_t(n), 3}), fields);
+  return py::make_tuple(positions, fields);
 }
 
 // A 1-D NumPy array of a PLY-representable dtype -> an attribute column (copied).
@@ -176,7 +182,8 @@ void bind_io(py::module_ m) {
         R"(Read a point cloud (.ply, .xyz/.pts/.txt/.csv, .pcd) with glint's readers.
 
 Returns:
-    (xyz, fields): xyz (N, 3) float32 positions (interleaved from glint's per-axis arrays);
+    (xyz, fields): xyz (N, 3) float32 positions (interleaved from glint's per-axis arrays;
+    float64 for a cloud whose centre lies beyond 1e4 from 0, which glint re-centres on read);
     fields: dict of the per-point properties by name (e.g. 'scalar_label', 'red'), each a
     1-D array of the stored type (copied).
 

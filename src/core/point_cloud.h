@@ -2,8 +2,10 @@
 // PointCloud: positions as structure of arrays plus named, typed optional per-point attributes
 // (labels, normals, colours, probabilities, anything a PLY vertex property can hold).
 //
-// Positions are float (metres or the file's own unit); clouds with large absolute coordinates
-// (georeferenced scans) should be re-centred before loading into float.
+// Positions are float (metres or the file's own unit) relative to `origin` (double): a point's
+// position is origin + (x, y, z). Readers re-centre a cloud that lies far from 0 (a scan at
+// 10^7 m) on an integer origin before its coordinates become float (set_positions below), so
+// features see the same floats as for the cloud at 0, and writers add the origin back.
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
@@ -32,6 +34,7 @@ double column_value(const AttributeColumn& column, std::size_t i);
 class PointCloud {
  public:
   std::vector<float> x, y, z;
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  // added to (x, y, z) on output
 
   std::size_t size() const { return x.size(); }
   bool empty() const { return x.empty(); }
@@ -62,5 +65,22 @@ class PointCloud {
  private:
   std::vector<NamedAttribute> attributes_;
 };
+
+// Largest |coordinate - origin| edge features accept, in the cloud's unit (1e9): beyond it
+// squared distances and covariance sums overflow float (a coordinate of 1e37 gave NaN
+// probabilities). Checked by edges::compute_features, not by the readers.
+inline constexpr double kMaxCloudCoordinate = 1e9;
+// A cloud whose bounding-box centre is farther from 0 than this (in its unit) and than its own
+// size is re-centred on read: float keeps 1 mm steps up to about 1e4.
+inline constexpr double kRecentreBeyond = 1e4;
+
+// Makes `cloud` hold the n points (x[i], y[i], z[i]) given in double: when the cloud's centre
+// lies farther from 0 than kRecentreBeyond and than the cloud's own size, it is re-centred on
+// the integer point nearest its bounding box's centre (float coordinates far from 0 then
+// round-trip exactly); otherwise origin = 0 and positions are as given. Attributes are
+// untouched (the cloud must hold n points or none). Throws glint::Error(file, "vertex i", ...)
+// for a non-finite coordinate or one that does not fit a float relative to the origin.
+void set_positions(PointCloud& cloud, const double* x, const double* y, const double* z,
+                   std::size_t n, const std::string& file);
 
 }  // namespace glint

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/interrupt.h"
+
 namespace glint {
 namespace {
 std::atomic<bool> quiet_flag{false};
@@ -48,6 +50,7 @@ ProgressBar::ProgressBar(std::string label, std::size_t total)
 ProgressBar::~ProgressBar() { finish(); }
 
 void ProgressBar::advance(std::size_t steps) {
+  throw_if_interrupted();  // a step of a long job: where Ctrl-C is noticed
   if (!enabled_) return;
   const std::size_t done = done_.fetch_add(steps) + steps;
   const int permille =

@@ -1,5 +1,6 @@
 #include "edges/features.h"
 
+#include <fmt/format.h>
 #include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
@@ -198,6 +199,15 @@ FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& par
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     if (!std::isfinite(cloud.x[i]) || !std::isfinite(cloud.y[i]) || !std::isfinite(cloud.z[i])) {
       throw Error("", "point " + std::to_string(i), "non-finite coordinate");
+    }
+    // Squared distances and covariance sums of larger coordinates overflow float: NaN
+    // probabilities (a coordinate of 1e37 gave them).
+    for (const float value : {cloud.x[i], cloud.y[i], cloud.z[i]}) {
+      if (std::abs(value) > kMaxCloudCoordinate)
+        throw Error("", "point " + std::to_string(i),
+                    fmt::format("coordinate {} is more than {:g} from the cloud's origin (the "
+                                "allowed range for edge features; split or rescale the cloud)",
+                                value, kMaxCloudCoordinate));
     }
   }
   if (cloud.size() < static_cast<std::size_t>(params.scales[0])) {

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/interrupt.h"
 
 namespace glint::io {
 namespace {
@@ -39,6 +40,7 @@ AtomicFile::~AtomicFile() {
 }
 
 void AtomicFile::commit() {
+  throw_if_interrupted();  // an interrupted job leaves no output, however far it got
   stream_.flush();
   const bool written = stream_.good();
   stream_.close();  // fails when the last buffered bytes cannot be written

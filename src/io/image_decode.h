@@ -14,8 +14,15 @@ namespace glint::io {
 // image (padding, appended data) are allowed; other formats are not checked.
 void require_complete_image(const std::string& path, std::string_view bytes);
 
+// Throws glint::Error(path, "header", ...) when the image's header (PNG, JPEG, OpenEXR, Radiance
+// HDR) declares a size beyond core/limits.h's pixel budget; other formats are not checked here.
+void require_image_size_allowed(const std::string& path, std::string_view bytes);
+
 // Reads and decodes the image file with cv::imdecode `flags`; throws glint::Error naming it
-// when it is missing, empty, truncated or not decodable.
+// when it is missing, empty, truncated, larger than the pixel budget (checked on the header,
+// before decoding) or not decodable. PNG goes through libpng with glint's own message
+// handlers (libpng's messages become part of the one error line, never a line of their own);
+// Radiance HDR is read from the file (no temporary copy).
 cv::Mat decode_image_file(const std::string& path, int flags);
 
 }  // namespace glint::io

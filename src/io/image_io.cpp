@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "io/atomic_file.h"
 #include "io/codec.h"
 #include "io/image_decode.h"
@@ -101,6 +102,8 @@ ImageF read_npy_image(const std::string& path) {
     throw Error(path, "", "an image array must be (height, width) or (height, width, channels)");
   const std::size_t channels = array.shape.size() == 3 ? array.shape[2] : 1;
   if (array.values.empty()) throw Error(path, "", "the image has no pixels");
+  limits::check_image_size(std::int64_t(array.shape[1]), std::int64_t(array.shape[0]), path,
+                           "shape");
   ImageF image(static_cast<int>(array.shape[1]), static_cast<int>(array.shape[0]),
                static_cast<int>(channels));
   const std::size_t pixels = image.pixel_count();

@@ -13,6 +13,7 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/interrupt.h"
 
 namespace glint::io {
 namespace {
@@ -501,6 +502,7 @@ void LasWriter::commit() {
     throw Error(path_, "", fmt::format("write failed: {}", std::strerror(errno)));
   }
   fd_ = -1;
+  throw_if_interrupted();  // an interrupted job leaves no output (the destructor unlinks it)
   if (std::rename(temporary_.c_str(), path_.c_str()) != 0) {
     throw Error(path_, "",
                 fmt::format("cannot rename the finished file: {}", std::strerror(errno)));

@@ -6,11 +6,13 @@
 #include <bit>
 #include <cctype>
 #include <cmath>
+#include <new>
 #include <optional>
 #include <string_view>
 #include <vector>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "io/atomic_file.h"
 #include "io/codec.h"
 #include "io/file_bytes.h"
@@ -182,7 +184,7 @@ Header parse_header(const std::string& path, const std::string& bytes) {
 // Where one vertex property goes: a position axis, an attribute column, or nowhere (lists).
 struct Slot {
   const Property* property = nullptr;
-  float* axis = nullptr;
+  double* axis = nullptr;  // positions are read in double and re-centred (set_positions)
   AttributeColumn* column = nullptr;
   char* column_bytes = nullptr;
 };
@@ -264,20 +266,28 @@ class BinaryBody {
   bool swap_;
 };
 
+// An ascii body: one record per line (blank lines are skipped). A line with fewer or more values
+// than its element's properties is an error naming the line, never read on into the next one.
 class AsciiBody {
  public:
-  AsciiBody(const std::string& path, std::string_view body)
-      : path_(path), tokens_(body.data(), body.data() + body.size()) {}
+  // `first_line`: the file's line number of the body's first line.
+  AsciiBody(const std::string& path, std::string_view body, std::size_t first_line)
+      : path_(path), rest_(body), line_number_(first_line - 1) {}
 
   // A record needs a token per property, and tokens are at least one character and a separator.
   std::size_t capacity(const Element& element) const {
     if (is_empty_record(element)) return element.count;
-    return (tokens_.remaining() + 1) / (2 * element.properties.size());
+    return (rest_.size() + 1) / (2 * element.properties.size());
   }
 
   double value(Scalar type, const Element& element, std::size_t index) {
-    const std::string_view token = tokens_.next();
-    if (token.empty()) truncated(element, index);
+    const std::string_view token = record(element, index).next();
+    if (token.empty()) {
+      if (rest_.find_first_not_of(" \t\r\n") == std::string_view::npos) truncated(element, index);
+      fail(element, index,
+           fmt::format("the line ends early: it has fewer values than the {} properties of {}",
+                       element.properties.size(), plural(element)));
+    }
     double result = 0;
     if (!parse_number(token, result)) {
       fail(element, index, fmt::format("not a number: '{}'", token.substr(0, 32)));
@@ -298,7 +308,8 @@ class AsciiBody {
     const double length = value(*property.list_length, element, index);
     if (!is_list_length(length)) fail(element, index, "invalid list length");
     // Each item needs a token of at least one character.
-    if (length > double(tokens_.remaining())) truncated(element, index);
+    if (length > double(line_.remaining()))
+      fail(element, index, "the list is longer than its line");
     return static_cast<std::size_t>(length);
   }
 
@@ -310,18 +321,52 @@ class AsciiBody {
   bool skip_fixed(const Element& element) { return is_empty_record(element); }
 
   [[noreturn]] void truncated(const Element& element, std::size_t index) const {
-    fail(element, index,
-         fmt::format("file truncated: expected {} {}", element.count, plural(element)));
+    throw Error(path_, record_name(element, index),
+                fmt::format("file truncated: expected {} {}", element.count, plural(element)));
+  }
+
+  // Checks that the last record read left nothing on its line.
+  void finish() {
+    if (!record_element_) return;
+    const std::string_view extra = line_.next();
+    if (!extra.empty())
+      fail(*record_element_, record_index_,
+           fmt::format("the line has more values than the {} properties of {} (from '{}')",
+                       record_element_->properties.size(), plural(*record_element_),
+                       extra.substr(0, 32)));
   }
 
  private:
+  // The tokens of record `index` of `element`: a new record starts on the next non-blank line.
+  Tokens& record(const Element& element, std::size_t index) {
+    if (&element == record_element_ && index == record_index_) return line_;
+    finish();
+    record_element_ = &element;
+    record_index_ = index;
+    std::string_view line;
+    do {
+      if (rest_.empty()) truncated(element, index);
+      const std::size_t end = rest_.find('\n');
+      line = rest_.substr(0, end);
+      rest_ = end == std::string_view::npos ? std::string_view() : rest_.substr(end + 1);
+      ++line_number_;
+    } while (line.find_first_not_of(" \t\r") == std::string_view::npos);
+    line_ = Tokens(line.data(), line.data() + line.size());
+    return line_;
+  }
+
   [[noreturn]] void fail(const Element& element, std::size_t index,
                          const std::string& reason) const {
-    throw Error(path_, record_name(element, index), reason);
+    throw Error(path_, fmt::format("line {} ({})", line_number_, record_name(element, index)),
+                reason);
   }
 
   const std::string& path_;
-  Tokens tokens_;
+  std::string_view rest_;  // the body after the current record's line
+  Tokens line_{nullptr, nullptr};
+  std::size_t line_number_;
+  const Element* record_element_ = nullptr;
+  std::size_t record_index_ = 0;
 };
 
 template <class Body>
@@ -338,34 +383,27 @@ void skip_element(Body& body, const Element& element) {
   }
 }
 
-float coordinate(const std::string& path, double value, std::size_t index) {
-  if (!std::isfinite(value)) {
-    throw Error(path, fmt::format("vertex {}", index), "non-finite coordinate");
+// Positions in double, before set_positions() re-centres them into the cloud's floats.
+struct Positions {
+  std::vector<double> x, y, z;
+  double* axis(const std::string& name) {
+    if (name == "x") return x.data();
+    if (name == "y") return y.data();
+    if (name == "z") return z.data();
+    return nullptr;
   }
-  if (!fits(Scalar::float32, value)) {
-    throw Error(path, fmt::format("vertex {}", index),
-                fmt::format("coordinate {} is outside the float range", value));
-  }
-  return static_cast<float>(value);
-}
-
-float* axis_of(PointCloud& cloud, const std::string& name) {
-  if (name == "x") return cloud.x.data();
-  if (name == "y") return cloud.y.data();
-  if (name == "z") return cloud.z.data();
-  return nullptr;
-}
+};
 
 // One slot per vertex property; `attributes` receives a column for each non-position scalar.
-std::vector<Slot> plan_slots(const Element& vertex, PointCloud& cloud,
+std::vector<Slot> plan_slots(const Element& vertex, std::size_t count, Positions& positions,
                              std::vector<NamedAttribute>& attributes) {
   attributes.reserve(vertex.properties.size());  // the slots point into it
   std::vector<Slot> slots;
   for (const Property& property : vertex.properties) {
     Slot slot{&property};
-    if (!property.list_length) slot.axis = axis_of(cloud, property.name);
+    if (!property.list_length) slot.axis = positions.axis(property.name);
     if (!property.list_length && !slot.axis) {
-      attributes.push_back({property.name, make_column(property.type, cloud.size())});
+      attributes.push_back({property.name, make_column(property.type, count)});
       slot.column = &attributes.back().values;
       slot.column_bytes = column_bytes(*slot.column);
     }
@@ -378,15 +416,21 @@ template <class Body>
 PointCloud read_vertices(const std::string& path, Body& body, const Element& vertex) {
   // Never allocate for more vertices than the rest of the file could hold.
   const std::size_t allocated = std::min(vertex.count, body.capacity(vertex));
-  PointCloud cloud;
-  cloud.resize(allocated);
+  Positions positions;
+  try {
+    for (std::vector<double>* axis : {&positions.x, &positions.y, &positions.z})
+      axis->resize(allocated);
+  } catch (const std::bad_alloc&) {
+    limits::throw_out_of_memory(fmt::format("the positions of {} vertices", allocated),
+                                24.0 * allocated);
+  }
   std::vector<NamedAttribute> attributes;
-  const std::vector<Slot> slots = plan_slots(vertex, cloud, attributes);
+  const std::vector<Slot> slots = plan_slots(vertex, allocated, positions, attributes);
   for (std::size_t i = 0; i < vertex.count; ++i) {
     if (i == allocated) body.truncated(vertex, i);
     for (const Slot& slot : slots) {
       if (slot.axis) {
-        slot.axis[i] = coordinate(path, body.value(slot.property->type, vertex, i), i);
+        slot.axis[i] = body.value(slot.property->type, vertex, i);
       } else if (slot.column) {
         body.attribute(slot, vertex, i);
       } else {
@@ -394,6 +438,8 @@ PointCloud read_vertices(const std::string& path, Body& body, const Element& ver
       }
     }
   }
+  PointCloud cloud;
+  set_positions(cloud, positions.x.data(), positions.y.data(), positions.z.data(), allocated, path);
   for (NamedAttribute& attribute : attributes) {
     cloud.set(attribute.name, std::move(attribute.values));
   }
@@ -501,8 +547,11 @@ auto read_with_body(const std::string& path, const Read& read) {
   const Element& vertex = vertex_element(path, header);
   const std::string_view body = std::string_view(bytes).substr(header.body_offset);
   if (header.format == PlyFormat::ascii) {
-    AsciiBody ascii(path, body);
-    return read(ascii, header, vertex);
+    const auto header_lines = std::count(bytes.begin(), bytes.begin() + header.body_offset, '\n');
+    AsciiBody ascii(path, body, static_cast<std::size_t>(header_lines) + 1);
+    auto result = read(ascii, header, vertex);
+    ascii.finish();
+    return result;
   }
   BinaryBody binary(path, body, needs_swap(header.format));
   return read(binary, header, vertex);
@@ -523,11 +572,23 @@ void check_attribute_names(const std::string& path, const PointCloud& cloud) {
   }
 }
 
+// A re-centred cloud (origin != 0) is written in double, origin + (x, y, z): its original
+// coordinates, where float would lose them.
+bool has_origin(const PointCloud& cloud) { return !cloud.origin.isZero(); }
+
+std::vector<double> world_axis(const PointCloud& cloud, int axis) {
+  const std::vector<float>& relative = axis == 0 ? cloud.x : axis == 1 ? cloud.y : cloud.z;
+  std::vector<double> world(relative.size());
+  for (std::size_t i = 0; i < relative.size(); ++i)
+    world[i] = cloud.origin[axis] + double(relative[i]);
+  return world;
+}
+
 std::string header_text(const PointCloud& cloud, PlyFormat format) {
   std::string header = fmt::format(
-      "ply\nformat {} 1.0\ncomment generated by glint\nelement vertex {}\n"
-      "property float x\nproperty float y\nproperty float z\n",
-      kFormatNames[static_cast<int>(format)], cloud.size());
+      "ply\nformat {0} 1.0\ncomment generated by glint\nelement vertex {1}\n"
+      "property {2} x\nproperty {2} y\nproperty {2} z\n",
+      kFormatNames[static_cast<int>(format)], cloud.size(), has_origin(cloud) ? "double" : "float");
   for (const NamedAttribute& attribute : cloud.attributes()) {
     header +=
         fmt::format("property {} {}\n", type_name(scalar_of(attribute.values)), attribute.name);
@@ -541,8 +602,16 @@ void write_binary_body(std::ostream& out, const PointCloud& cloud, bool swap) {
     std::size_t size;
   };
   std::vector<Column> columns;
-  for (const std::vector<float>* axis : {&cloud.x, &cloud.y, &cloud.z}) {
-    columns.push_back({reinterpret_cast<const char*>(axis->data()), sizeof(float)});
+  std::vector<double> world[3];
+  if (has_origin(cloud)) {
+    for (int a = 0; a < 3; ++a) {
+      world[a] = world_axis(cloud, a);
+      columns.push_back({reinterpret_cast<const char*>(world[a].data()), sizeof(double)});
+    }
+  } else {
+    for (const std::vector<float>* axis : {&cloud.x, &cloud.y, &cloud.z}) {
+      columns.push_back({reinterpret_cast<const char*>(axis->data()), sizeof(float)});
+    }
   }
   for (const NamedAttribute& attribute : cloud.attributes()) {
     columns.push_back({column_bytes(attribute.values), size_of(scalar_of(attribute.values))});
@@ -562,9 +631,16 @@ void write_binary_body(std::ostream& out, const PointCloud& cloud, bool swap) {
 void write_ascii_body(std::ostream& out, const PointCloud& cloud) {
   std::string buffer;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    for (const float value : {cloud.x[i], cloud.y[i], cloud.z[i]}) {
-      append_value(buffer, value);
-      buffer += ' ';
+    if (has_origin(cloud)) {
+      for (int a = 0; a < 3; ++a) {
+        const float relative = a == 0 ? cloud.x[i] : a == 1 ? cloud.y[i] : cloud.z[i];
+        fmt::format_to(std::back_inserter(buffer), "{} ", cloud.origin[a] + double(relative));
+      }
+    } else {
+      for (const float value : {cloud.x[i], cloud.y[i], cloud.z[i]}) {
+        append_value(buffer, value);
+        buffer += ' ';
+      }
     }
     for (const NamedAttribute& attribute : cloud.attributes()) {
       append_value(buffer, attribute.values, i);

@@ -4,6 +4,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "io/rgbd_parsing.h"
 #include "io/rgbd_sequence.h"
 
@@ -26,7 +27,7 @@ Intrinsics read_camera_intrinsics(const std::string& folder, const std::string& 
   rgbd::require_file(path, "camera-intrinsics.txt (3x3 K)");
   const Eigen::MatrixXd k = rgbd::parse_matrix(path, rgbd::read_rows(path), 0, 3, 3);
   Intrinsics intrinsics{width, height, k(0, 0), k(1, 1), k(0, 2), k(1, 2)};
-  if (!intrinsics.valid()) throw Error(path, "", "K has a zero focal length");
+  limits::check_intrinsics(intrinsics, path, "K");
   return intrinsics;
 }
 
@@ -39,6 +40,15 @@ RgbdSequence open_7scenes_sequence(const std::string& folder) {
     const std::string name = entry.path().filename().string();
     if (name.starts_with("frame-") && name.ends_with(".depth.png"))
       stems.push_back(name.substr(0, name.size() - std::string(".depth.png").size()));
+  }
+  // Frames are listed by their depth images: a colour image without one would be dropped.
+  for (const auto& entry : std::filesystem::directory_iterator(frames)) {
+    const std::string name = entry.path().filename().string();
+    if (name.starts_with("frame-") && name.ends_with(".color.png"))
+      rgbd::require_file(
+          rgbd::join(frames,
+                     name.substr(0, name.size() - std::string(".color.png").size()) + ".depth.png"),
+          "the depth image of " + name);
   }
   std::sort(stems.begin(), stems.end());
   if (stems.empty()) throw Error(frames, "", "no frame-*.depth.png files");

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "io/file_bytes.h"
 #include "io/image_decode.h"
 
@@ -72,6 +73,7 @@ Pose pose_from_matrix(const std::string& path, const std::string& element,
   Pose pose = Pose::Identity();
   pose.linear() = svd.matrixU() * svd.matrixV().transpose();
   pose.translation() = matrix.topRightCorner<3, 1>();
+  limits::check_position(pose.translation(), path, element.empty() ? "translation" : element);
   return pose;
 }
 

@@ -4,6 +4,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "io/json_report.h"
 #include "io/rgbd_parsing.h"
 #include "io/rgbd_sequence.h"
@@ -34,7 +35,7 @@ Intrinsics read_open3d_intrinsics(const std::string& path) {
     if (k.size() != 9) throw Error(path, "intrinsic_matrix", "expected 9 numbers");
     Intrinsics intrinsics{
         json.at("width").get<int>(), json.at("height").get<int>(), k[0], k[4], k[6], k[7]};
-    if (!intrinsics.valid()) throw Error(path, "", "zero size or focal length");
+    limits::check_intrinsics(intrinsics, path, "intrinsic_matrix");
     return intrinsics;
   } catch (const nlohmann::json::exception& e) {
     throw Error(path, "", std::string("expected width, height, intrinsic_matrix: ") + e.what());

@@ -57,7 +57,7 @@ class TextCloudReader {
   // `max_points` bounds the number of points (the number of lines), to reserve memory once.
   TextCloudReader(const std::string& path, bool point_count_line, std::size_t max_points)
       : path_(path), point_count_line_(point_count_line), max_points_(max_points) {
-    cloud_.reserve(max_points);
+    for (std::vector<double>& axis : positions_) axis.reserve(max_points);
   }
 
   void take_line(std::string_view line, std::size_t number) {
@@ -65,7 +65,7 @@ class TextCloudReader {
     const bool comment = strip_comment(line);
     split(line, tokens_);
     if (tokens_.empty()) return;
-    if (cloud_.empty() && names_.empty() && is_column_header(tokens_)) {
+    if (positions_[0].empty() && names_.empty() && is_column_header(tokens_)) {
       names_.assign(tokens_.begin(), tokens_.end());
       return;
     }
@@ -80,11 +80,13 @@ class TextCloudReader {
   }
 
   PointCloud finish() {
-    if (announced_ && *announced_ != cloud_.size()) {
-      throw Error(
-          path_, fmt::format("line {}", announced_line_),
-          fmt::format("announces {} points, the file holds {}", *announced_, cloud_.size()));
+    const std::size_t points = positions_[0].size();
+    if (announced_ && *announced_ != points) {
+      throw Error(path_, fmt::format("line {}", announced_line_),
+                  fmt::format("announces {} points, the file holds {}", *announced_, points));
     }
+    set_positions(cloud_, positions_[0].data(), positions_[1].data(), positions_[2].data(), points,
+                  path_);
     for (std::size_t c = 0; c < extra_.size(); ++c) {
       cloud_.set(column_name(c + 3), std::move(extra_[c]));
     }
@@ -107,7 +109,7 @@ class TextCloudReader {
 
   // A .pts file may start with a line holding only the number of points.
   bool is_count_line() const {
-    return point_count_line_ && cloud_.empty() && !announced_ && values_.size() == 1 &&
+    return point_count_line_ && positions_[0].empty() && !announced_ && values_.size() == 1 &&
            is_non_negative_whole(values_[0]) && values_[0] <= kMaxCount;
   }
 
@@ -119,11 +121,12 @@ class TextCloudReader {
     }
     for (std::size_t c = 0; c < columns_; ++c) {
       if (c < 3 && !std::isfinite(values_[c])) fail("non-finite coordinate");
-      if (!fits(Scalar::float32, values_[c])) {
+      if (c >= 3 && !fits(Scalar::float32, values_[c])) {
         fail(fmt::format("'{}' is outside the float range", tokens_[c]));
       }
     }
-    cloud_.push_back(float(values_[0]), float(values_[1]), float(values_[2]));
+    // Positions stay double until finish() re-centres them (core/point_cloud.h).
+    for (int a = 0; a < 3; ++a) positions_[a].push_back(values_[a]);
     for (std::size_t c = 3; c < columns_; ++c) {
       extra_[c - 3].push_back(static_cast<float>(values_[c]));
       integral_[c - 3] = integral_[c - 3] && is_non_negative_whole(values_[c]);
@@ -161,6 +164,7 @@ class TextCloudReader {
   std::size_t columns_ = 0;
   std::size_t first_row_line_ = 0;
   PointCloud cloud_;
+  std::vector<double> positions_[3];
   std::vector<std::vector<float>> extra_;  // the columns after x y z
   std::vector<bool> integral_;  // whether an extra column holds only non-negative whole numbers
 };
@@ -197,9 +201,15 @@ void write_text_cloud(const std::string& path, const PointCloud& cloud) {
   std::string buffer = "//x y z";
   for (const NamedAttribute& attribute : cloud.attributes()) buffer += " " + attribute.name;
   buffer += '\n';
+  const bool shifted = !cloud.origin.isZero();  // re-centred: write the original coordinates
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    for (const float value : {cloud.x[i], cloud.y[i], cloud.z[i]}) {
-      append_value(buffer, value);
+    for (int a = 0; a < 3; ++a) {
+      const float value = a == 0 ? cloud.x[i] : a == 1 ? cloud.y[i] : cloud.z[i];
+      if (shifted) {
+        fmt::format_to(std::back_inserter(buffer), "{}", cloud.origin[a] + double(value));
+      } else {
+        append_value(buffer, value);
+      }
       buffer += ' ';
     }
     for (const NamedAttribute& attribute : cloud.attributes()) {

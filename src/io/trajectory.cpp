@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "io/atomic_file.h"
 #include "io/json_report.h"
 #include "io/rgbd_parsing.h"
@@ -27,6 +28,7 @@ std::vector<StampedPose> read_tum_trajectory(const std::string& path) {
     stamped.timestamp = v[0];
     stamped.pose.linear() = q.normalized().toRotationMatrix();
     stamped.pose.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+    limits::check_position(stamped.pose.translation(), path, element + " (tx ty tz)");
     poses.push_back(stamped);
   }
   return poses;
@@ -61,8 +63,7 @@ Intrinsics intrinsics_from_json(const nlohmann::json& json, const std::string& p
     throw Error(path, "",
                 std::string("intrinsics need width, height, fx, fy, cx, cy: ") + e.what());
   }
-  if (!k.valid())
-    throw Error(path, "", "intrinsics need a positive width and height and non-zero fx, fy");
+  limits::check_intrinsics(k, path, "");
   return k;
 }
 

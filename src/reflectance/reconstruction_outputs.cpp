@@ -6,6 +6,7 @@
 #include <map>
 
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "fusion/depth_maps.h"
@@ -176,6 +177,7 @@ ReconstructionFolder::~ReconstructionFolder() {
 }
 
 void ReconstructionFolder::commit() {
+  throw_if_interrupted();
   fs::remove_all(output_);
   fs::rename(partial_, output_);
   committed_ = true;

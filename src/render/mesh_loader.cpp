@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "io/ply.h"
 
 namespace glint::render {
@@ -66,7 +67,8 @@ TriangleMesh read_ply_mesh(const std::string& path) {
   TriangleMesh mesh;
   mesh.vertices.reserve(ply.vertices.size());
   for (std::size_t v = 0; v < ply.vertices.size(); ++v)
-    mesh.vertices.push_back(ply.vertices.point(v));
+    mesh.vertices.push_back(
+        (ply.vertices.origin + ply.vertices.point(v).cast<double>()).cast<float>());
   mesh.triangles = std::move(ply.triangles);
   return mesh;
 }
@@ -78,9 +80,13 @@ TriangleMesh load_mesh(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();
   std::ranges::transform(extension, extension.begin(),
                          [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (extension == ".obj") return read_obj_mesh(path);
-  if (extension == ".ply") return read_ply_mesh(path);
-  throw Error(path, "", "unknown mesh format (expected .obj or .ply)");
+  if (extension != ".obj" && extension != ".ply")
+    throw Error(path, "", "unknown mesh format (expected .obj or .ply)");
+  TriangleMesh mesh = extension == ".obj" ? read_obj_mesh(path) : read_ply_mesh(path);
+  // A NaN or huge vertex would reach the ray tracer's bounding boxes (and its assertions).
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
+    limits::check_position(mesh.vertices[v].cast<double>(), path, fmt::format("vertex {}", v));
+  return mesh;
 }
 
 void normalise_mesh(TriangleMesh& mesh, double height_m) {

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "io/json_report.h"
 #include "io/trajectory.h"
 #include "render/trajectories.h"
@@ -18,6 +19,7 @@ using nlohmann::json;
 namespace fs = std::filesystem;
 
 constexpr const char* kShapeNames[] = {"mesh", "box", "sphere", "plane"};
+constexpr double kMaxOrbitFrames = 1e6;
 
 // Reads typed values out of the parsed document; every failure names the file and the element
 // path ("objects[2].material.alpha").
@@ -28,6 +30,19 @@ class SceneReader {
 
   [[noreturn]] void fail(const std::string& element, const std::string& reason) const {
     throw Error(path_, element, reason);
+  }
+  const std::string& path() const { return path_; }
+
+  // A number that must be an integer in [lowest, highest] (core/limits.h).
+  int integer_in(double value, double lowest, double highest, const std::string& element) const {
+    limits::check_integer(value, lowest, highest, path_, element);
+    return static_cast<int>(value);
+  }
+  // A position in metres within the world extent (core/limits.h).
+  Eigen::Vector3d position(const json& value, const std::string& element) const {
+    const Eigen::Vector3d p = vector3(value, element);
+    limits::check_position(p, path_, element);
+    return p;
   }
 
   // Rejects keys outside `known` (catches typos that would silently fall back to defaults).
@@ -111,7 +126,7 @@ Eigen::Isometry3d read_transform(const SceneReader& reader, const json& value,
   reader.expect_object(value, element, {"position", "rotation", "quaternion"});
   Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();
   if (value.contains("position"))
-    transform.translation() = reader.vector3(value["position"], element + ".position");
+    transform.translation() = reader.position(value["position"], element + ".position");
   if (value.contains("rotation") && value.contains("quaternion"))
     reader.fail(element, "give either 'rotation' or 'quaternion', not both");
   if (value.contains("quaternion"))
@@ -158,10 +173,9 @@ Object read_object(const SceneReader& reader, const json& value, std::size_t ind
   Object object;
   object.name = value.contains("name") ? reader.text(value["name"], element + ".name")
                                        : fmt::format("object{}", index + 1);
-  const double id = reader.number_or(value, "id", double(index + 1), element);
-  if (id < 0 || id > 65535 || id != std::floor(id))
-    reader.fail(element + ".id", "must be an integer in [0, 65535]");
-  object.id = static_cast<int>(id);
+  // Id 0 is the background of the gt/segment maps.
+  object.id = reader.integer_in(reader.number_or(value, "id", double(index + 1), element), 1, 65535,
+                                element + ".id");
   const std::string shape =
       reader.text(reader.required(value, "shape", element), element + ".shape");
   bool known = false;
@@ -180,6 +194,7 @@ Object read_object(const SceneReader& reader, const json& value, std::size_t ind
   if (value.contains("size"))  // one number: the same size on every axis
     object.size = reader.number_or_vector3(value["size"], element + ".size");
   if (!(object.size.minCoeff() > 0)) reader.fail(element + ".size", "sizes must be > 0");
+  limits::check_position(object.size, reader.path(), element + ".size");
   if (value.contains("transform"))
     object.transform = read_transform(reader, value["transform"], element + ".transform");
   if (value.contains("material"))
@@ -192,7 +207,7 @@ PointLight read_light(const SceneReader& reader, const json& value, std::size_t 
   reader.expect_object(value, element, {"position", "intensity", "proxy_radius_m"});
   PointLight light;
   light.position =
-      reader.vector3(reader.required(value, "position", element), element + ".position");
+      reader.position(reader.required(value, "position", element), element + ".position");
   if (value.contains("intensity"))
     light.intensity = reader.colour(value["intensity"], element + ".intensity");
   light.proxy_radius_m = reader.number_or(value, "proxy_radius_m", light.proxy_radius_m, element);
@@ -210,10 +225,9 @@ Environment read_environment(const SceneReader& reader, const json& value) {
   environment.scale = static_cast<float>(reader.number_or(value, "scale", 1.0, element));
   environment.rotation_deg =
       static_cast<float>(reader.number_or(value, "rotation_deg", 0.0, element));
-  const double samples = reader.number_or(value, "samples", environment.samples, element);
-  if (samples < 1 || samples != std::floor(samples))
-    reader.fail(element + ".samples", "must be an integer >= 1");
-  environment.samples = static_cast<int>(samples);
+  environment.samples =
+      reader.integer_in(reader.number_or(value, "samples", environment.samples, element), 1,
+                        limits::kMaxSamplesPerPixel, element + ".samples");
   if (environment.scale < 0) reader.fail(element + ".scale", "must be >= 0");
   return environment;
 }
@@ -233,7 +247,7 @@ CameraSettings read_camera(const SceneReader& reader, const json& value) {
     in.fy = reader.number(reader.required(k, "fy", at), at + ".fy");
     in.cx = reader.number(reader.required(k, "cx", at), at + ".cx");
     in.cy = reader.number(reader.required(k, "cy", at), at + ".cy");
-    if (!in.valid()) reader.fail(at, "width, height must be > 0 and fx, fy non-zero");
+    limits::check_intrinsics(in, reader.path(), at);
   }
   camera.exposure = static_cast<float>(reader.number_or(value, "exposure", 1.0, element));
   camera.sensor_noise = static_cast<float>(reader.number_or(value, "sensor_noise", 0.0, element));
@@ -267,21 +281,27 @@ std::vector<Pose> read_trajectory(const SceneReader& reader, const json& value) 
       reader.expect_object(orbit, at,
                            {"center", "radius", "height", "frames", "revolutions", "start_deg"});
       OrbitParams params;
-      params.ring.centre = reader.vector3(reader.required(orbit, "center", at), at + ".center");
+      params.ring.centre = reader.position(reader.required(orbit, "center", at), at + ".center");
       params.ring.target = params.ring.centre;
       params.ring.radius_m = reader.number(reader.required(orbit, "radius", at), at + ".radius");
       params.ring.height_m = reader.number_or(orbit, "height", 0.0, at);
-      const double frames = reader.number(reader.required(orbit, "frames", at), at + ".frames");
-      if (frames < 1 || frames != std::floor(frames))
-        reader.fail(at + ".frames", "must be an integer >= 1");
+      params.frames =
+          reader.integer_in(reader.number(reader.required(orbit, "frames", at), at + ".frames"), 1,
+                            kMaxOrbitFrames, at + ".frames");
       if (!(params.ring.radius_m > 0)) reader.fail(at + ".radius", "must be > 0");
-      params.frames = static_cast<int>(frames);
       params.arc_deg = 360.0 * reader.number_or(orbit, "revolutions", 1.0, at);
       params.start_deg = reader.number_or(orbit, "start_deg", 0.0, at);
-      poses = orbit_trajectory(params);
+      try {
+        poses = orbit_trajectory(params);
+      } catch (const Error& e) {  // e.g. a camera looking straight down: name it here
+        reader.fail(element + (e.element().empty() ? "" : "." + e.element()), e.reason());
+      }
     }
   }
   if (poses.empty()) reader.fail(element, "the trajectory has no poses");
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    limits::check_position(poses[i].translation(), reader.path(),
+                           fmt::format("{}[{}] position", element, i));
   return poses;
 }
 
@@ -330,8 +350,14 @@ Scene read_scene_json(const std::string& path) {
   Scene scene;
   const json& objects = reader.required(document, "objects", "");
   if (!objects.is_array()) reader.fail("objects", "expected an array");
-  for (std::size_t i = 0; i < objects.size(); ++i)
+  for (std::size_t i = 0; i < objects.size(); ++i) {
     scene.objects.push_back(read_object(reader, objects[i], i));
+    for (std::size_t j = 0; j < i; ++j)  // ids name the objects in gt/segment: one each
+      if (scene.objects[j].id == scene.objects[i].id)
+        reader.fail(fmt::format("objects[{}].id", i),
+                    fmt::format("{} is already the id of objects[{}]; ids must be unique",
+                                scene.objects[i].id, j));
+  }
   if (document.contains("lights")) {
     if (!document["lights"].is_array()) reader.fail("lights", "expected an array");
     for (std::size_t i = 0; i < document["lights"].size(); ++i)
@@ -344,14 +370,11 @@ Scene read_scene_json(const std::string& path) {
   scene.frames_per_second = reader.number_or(document, "fps", scene.frames_per_second, "");
   if (!(scene.frames_per_second > 0)) reader.fail("fps", "must be > 0");
   scene.shadows = reader.boolean_or(document, "shadows", scene.shadows, "");
-  const double bounces = reader.number_or(document, "bounces", scene.bounces, "");
-  if (bounces < 0 || bounces != std::floor(bounces))
-    reader.fail("bounces", "must be an integer >= 0");
-  scene.bounces = static_cast<int>(bounces);
-  const double samples = reader.number_or(document, "indirect_samples", scene.indirect_samples, "");
-  if (samples < 1 || samples != std::floor(samples))
-    reader.fail("indirect_samples", "must be an integer >= 1");
-  scene.indirect_samples = static_cast<int>(samples);
+  scene.bounces = reader.integer_in(reader.number_or(document, "bounces", scene.bounces, ""), 0,
+                                    limits::kMaxBounces, "bounces");
+  scene.indirect_samples =
+      reader.integer_in(reader.number_or(document, "indirect_samples", scene.indirect_samples, ""),
+                        1, limits::kMaxSamplesPerPixel, "indirect_samples");
   if (document.contains("seed")) {
     const json& seed = document["seed"];
     if (!seed.is_number_unsigned()) reader.fail("seed", "expected a non-negative integer");

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/timer.h"
@@ -113,6 +114,7 @@ SequenceStats write_sequence(const Scene& scene, const std::string& out_dir,
   std::optional<ProgressBar> progress;
   if (options.progress) progress.emplace("render", static_cast<std::size_t>(count));
   for (int frame = first; frame < first + count; ++frame) {
+    throw_if_interrupted();  // also without a progress bar
     Stopwatch frame_watch;
     const Pose& pose = scene.trajectory[frame];
     const FrameBuffers buffers = renderer.render(pose, frame);
@@ -151,6 +153,7 @@ SequenceStats write_sequence(const Scene& scene, const std::string& out_dir,
   io::write_tum_trajectory((staging / "groundtruth.txt").string(), groundtruth);
   write_scene_json((staging / "scene.json").string(), scene);
 
+  throw_if_interrupted();
   fs::remove_all(out_dir, error);
   if (!error) fs::rename(staging, out_dir, error);
   if (error)

@@ -15,15 +15,39 @@ void require_frames(int frames, const char* what) {
   if (frames < 1) throw Error(what, "frames", fmt::format("{} frames; need at least 1", frames));
 }
 
+// pose(i) for every frame; a look_at failure names the trajectory and the frame.
+template <class PoseOf>
+std::vector<Pose> frame_poses(const char* what, int frames, PoseOf&& pose) {
+  require_frames(frames, what);
+  std::vector<Pose> poses;
+  poses.reserve(static_cast<std::size_t>(frames));
+  for (int i = 0; i < frames; ++i) {
+    try {
+      poses.push_back(pose(i));
+    } catch (const Error& e) {
+      throw Error(e.file(), fmt::format("{} frame {}", what, i), e.reason());
+    }
+  }
+  return poses;
+}
+
 }  // namespace
 
 Pose look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, const Eigen::Vector3d& up) {
   const Eigen::Vector3d forward = target - eye;
-  if (forward.norm() < 1e-12) throw Error("look_at", "", "eye and target coincide");
+  if (forward.norm() < 1e-12)
+    throw Error("", "",
+                fmt::format("the camera at ({:g}, {:g}, {:g}) and its target coincide", eye.x(),
+                            eye.y(), eye.z()));
   const Eigen::Vector3d z = forward.normalized();
   const Eigen::Vector3d x_unnormalised = z.cross(up);  // image right = forward x up
   if (x_unnormalised.norm() < 1e-9 * up.norm())
-    throw Error("look_at", "", "the view direction is parallel to the up vector");
+    throw Error("", "",
+                fmt::format("the camera at ({:g}, {:g}, {:g}) looks at ({:g}, {:g}, {:g}), "
+                            "parallel to the up vector ({:g}, {:g}, {:g}): its image has no "
+                            "'up'; move the camera sideways (e.g. a larger orbit radius)",
+                            eye.x(), eye.y(), eye.z(), target.x(), target.y(), target.z(), up.x(),
+                            up.y(), up.z()));
   const Eigen::Vector3d x = x_unnormalised.normalized();
   const Eigen::Vector3d y = z.cross(x);  // image down
   Pose pose = Pose::Identity();
@@ -43,25 +67,17 @@ Pose ring_pose(const CameraRing& ring, double azimuth_deg, double height_offset_
 }
 
 std::vector<Pose> orbit_trajectory(const OrbitParams& params) {
-  require_frames(params.frames, "orbit");
-  std::vector<Pose> poses;
-  poses.reserve(static_cast<std::size_t>(params.frames));
-  for (int i = 0; i < params.frames; ++i)
-    poses.push_back(ring_pose(params.ring, params.start_deg + params.arc_deg * i / params.frames));
-  return poses;
+  return frame_poses("orbit", params.frames, [&](int i) {
+    return ring_pose(params.ring, params.start_deg + params.arc_deg * i / params.frames);
+  });
 }
 
 std::vector<Pose> oscillation_trajectory(const OscillationParams& params) {
-  require_frames(params.frames, "oscillation");
-  std::vector<Pose> poses;
-  poses.reserve(static_cast<std::size_t>(params.frames));
-  for (int i = 0; i < params.frames; ++i) {
+  return frame_poses("oscillation", params.frames, [&](int i) {
     const double phase = 2 * M_PI * params.periods * i / params.frames;
-    poses.push_back(ring_pose(params.ring,
-                              params.centre_deg + params.amplitude_deg * std::sin(phase),
-                              params.height_amplitude_m * std::sin(2 * phase)));
-  }
-  return poses;
+    return ring_pose(params.ring, params.centre_deg + params.amplitude_deg * std::sin(phase),
+                     params.height_amplitude_m * std::sin(2 * phase));
+  });
 }
 
 std::vector<Pose> light_capture_trajectory(const std::vector<Eigen::Vector3d>& light_positions,

@@ -3,6 +3,7 @@
 // output left behind).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -93,6 +94,43 @@ TEST_F(DenoiseCliTest, BadInputsGiveOneLineErrors) {
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.output.find("nope.png"), std::string::npos) << missing.output;
   EXPECT_FALSE(fs::exists(path("m.png")));
+}
+
+// A 389-byte PNG declaring 20000x20000 ran for minutes at 2.4 GB; a damaged one printed
+// libpng's own line before glint's.
+TEST_F(DenoiseCliTest, ImageHeadersAreCheckedAndLibpngSpeaksInGlintsLine) {
+  auto big_endian = [](std::uint32_t value) {
+    return std::string{char(value >> 24), char(value >> 16), char(value >> 8), char(value)};
+  };
+  std::ofstream(path("huge.png"), std::ios::binary)
+      << std::string("\x89PNG\r\n\x1a\n", 8) << big_endian(13) << "IHDR" << big_endian(20000)
+      << big_endian(20000) << std::string("\x08\x02\x00\x00\x00", 5) << big_endian(0)
+      << big_endian(0) << "IEND" << big_endian(0xAE426082);
+  const CommandResult huge =
+      glint("denoise noise-map " + path("huge.png") + " -o " + path("m.png"));
+  EXPECT_EQ(huge.exit_code, 1);
+  EXPECT_EQ(huge.output, "glint: error: " + path("huge.png") +
+                             ": header: 20000x20000 pixels is outside the allowed image size (each "
+                             "side 1 to 65535, at most 134217728 pixels in all)\n");
+  EXPECT_FALSE(fs::exists(path("m.png")));
+
+  std::string bytes;
+  {
+    std::ifstream in(path("noisy.png"), std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::size_t data = bytes.find("IDAT") + 8;
+  bytes[data] = char(bytes[data] ^ 0x55);
+  std::ofstream(path("damaged.png"), std::ios::binary) << bytes;
+  const CommandResult damaged =
+      glint("denoise noise-map " + path("damaged.png") + " -o " + path("m.png"));
+  EXPECT_EQ(damaged.exit_code, 1);
+  // One line with libpng's reason (zlib meets the damage before the chunk's CRC is checked).
+  EXPECT_EQ(damaged.output.rfind(
+                "glint: error: " + path("damaged.png") + ": not a readable PNG: IDAT: ", 0),
+            0u)
+      << damaged.output;
+  EXPECT_EQ(std::count(damaged.output.begin(), damaged.output.end(), '\n'), 1);
 }
 
 }  // namespace

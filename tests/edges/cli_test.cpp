@@ -121,6 +121,29 @@ TEST_F(CliTest, BadInputsGiveOneLineAndNoOutput) {
   EXPECT_NE(run.output.find("truncated.ply"), std::string::npos) << run.output;
 }
 
+// --png into a missing folder failed after OUT.ply was written, leaving it behind; now the
+// folder is made, and a --png that cannot be written is refused before anything is.
+TEST_F(CliTest, ClassifyWritesBothOutputsOrNeither) {
+  const std::string cloud = path("cube.xyz");
+  {
+    std::ofstream out(cloud);
+    for (int i = 0; i < 600; ++i)
+      out << (i % 10) * 0.1 << " " << (i / 10 % 10) * 0.1 << " " << (i / 100) * 0.1 << "\n";
+  }
+  CommandResult run = glint("edges classify " + cloud + " -o " + path("out.ply") + " --png " +
+                            path("pictures/new/out.png"));
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_TRUE(fs::exists(path("out.ply")));
+  EXPECT_TRUE(fs::exists(path("pictures/new/out.png")));
+
+  std::ofstream(path("a-file")) << "not a folder";
+  run = glint("edges classify " + cloud + " -o " + path("never.ply") + " --png " +
+              path("a-file/out.png"));
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.output.find("is a file, not a folder"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(path("never.ply")));
+}
+
 TEST_F(CliTest, HelpOnEveryLevel) {
   for (const char* command : {"", "edges", "edges classify", "edges train", "edges synth",
                               "edges eval", "edges features"}) {

@@ -3,9 +3,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "io_test_support.h"
 
 namespace glint::io {
@@ -56,6 +58,20 @@ TEST(AtomicFile, CommitReplacesTheTargetAndLeavesNoTemporary) {
   }
   EXPECT_EQ(read_text(path), "new\n");
   EXPECT_EQ(files_in(test::scratch_folder()), std::vector<std::string>{"atomic.bin"});
+}
+
+// A job interrupted by SIGINT however late leaves no output: the commit itself checks.
+TEST(AtomicFile, CommitAfterAnInterruptLeavesNothing) {
+  const std::filesystem::path folder = test::scratch_folder() / "interrupted";
+  std::filesystem::create_directories(folder);
+  {
+    AtomicFile file((folder / "out.txt").string());
+    file.stream() << "finished";
+    set_interrupt_signal_for_testing(SIGINT);
+    EXPECT_THROW(file.commit(), Interrupted);
+    set_interrupt_signal_for_testing(0);
+  }
+  EXPECT_TRUE(files_in(folder).empty());
 }
 
 TEST(AtomicFile, CreatesMissingFolders) {

@@ -242,17 +242,43 @@ TEST(Ply, MalformedAsciiValuesNameTheVertex) {
   const std::string header =
       "ply\nformat ascii 1.0\nelement vertex 2\n" + kXyz + "property uchar label\nend_header\n";
   expect_ply_error(header + "0 0 0 1\n1 1\n", "vertex 1", "file truncated: expected 2 vertices");
-  expect_ply_error(header + "0 0 0 1\n1 one 1 0\n", "vertex 1", "not a number: 'one'");
-  expect_ply_error(header + "0 0 0 1\n1 1 1 300\n", "vertex 1",
+  // The body starts on line 9.
+  expect_ply_error(header + "0 0 0 1\n1 one 1 0\n", "line 10 (vertex 1)", "not a number: 'one'");
+  expect_ply_error(header + "0 0 0 1\n1 1 1 300\n", "line 10 (vertex 1)",
                    "300 does not fit the property type uchar");
-  expect_ply_error(header + "0 0 0 1.5\n1 1 1 3\n", "vertex 0", "does not fit");
+  expect_ply_error(header + "0 0 0 1.5\n1 1 1 3\n", "line 9 (vertex 0)", "does not fit");
   expect_ply_error(header + "0 0 0 1\n1 nan 1 0\n", "vertex 1", "non-finite coordinate");
-  expect_ply_error(header + "0 0 0 1\n1 1 1e39 0\n", "vertex 1",
+  expect_ply_error(header + "0 0 0 1\n1 1 1e39 0\n", "line 10 (vertex 1)",
                    "1e39 does not fit the property type float");
+  // 1e300 from its neighbour: no origin brings both within float's range.
   expect_ply_error(
-      "ply\nformat ascii 1.0\nelement vertex 1\nproperty double x\n"
-      "property double y\nproperty double z\nend_header\n1 1e300 1\n",
-      "vertex 0", "coordinate 1e+300 is outside the float range");
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\n"
+      "property double y\nproperty double z\nend_header\n0 0 0\n1 1e300 1\n",
+      "vertex 1", "is 1e+300 from the cloud's origin 0: outside the float range");
+}
+
+// One record per line: a line with a value too many or too few is named, never read on into
+// the next vertex (which shifted every following vertex).
+TEST(Ply, AsciiLinesWithExtraOrMissingValuesNameTheLine) {
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\n" + kXyz + "property uchar label\nend_header\n";
+  expect_ply_error(header + "0 0 0 1\n1 1 1 0 7\n2 2 2 0\n", "line 10 (vertex 1)",
+                   "the line has more values than the 4 properties of vertices (from '7')");
+  expect_ply_error(header + "0 0 0 1\n1 1 1\n2 2 2 0 1\n", "line 10 (vertex 1)",
+                   "the line ends early: it has fewer values than the 4 properties of vertices");
+  expect_ply_error(header + "0 0 0 1\n1 1 1 0\n2 2 2 0 9\n", "line 11 (vertex 2)", "more values");
+  // Faces too: a list longer than its line.
+  expect_ply_error(
+      "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int vertex_indices\n"
+      "element vertex 1\n" +
+          kXyz + "end_header\n3 0 0\n0 0 0\n",
+      "line 10 (face 0)", "the line ends early");
+  // Blank lines between records are fine.
+  const std::string blank = scratch("blank.ply");
+  test::write_text(blank, header + "0 0 0 1\n\n1 1 1 0\n  \n2 2 2 2\n");
+  const PointCloud cloud = read_ply(blank);
+  ASSERT_EQ(cloud.size(), 3u);
+  EXPECT_EQ(cloud.z[2], 2.0f);
 }
 
 TEST(Ply, NonFiniteBinaryCoordinatesNameTheVertex) {
