@@ -173,7 +173,8 @@ constexpr int kRaysInFlight = 4;
 // time. Also compiled for x86-64-v3 (one-instruction rounding, fused multiply-adds, so the last
 // bits of a hit differ from the baseline build's). Interleaved rays overlap their chains of
 // dependent loads; the clone pays only with them.
-// clang-14 (the fuzz build) refuses flatten on a multiversioned function: there the inliner decides.
+// clang-14 (the fuzz build) refuses flatten on a multiversioned function; there the inliner
+// decides.
 #if defined(__clang__)
 __attribute__((target_clones("arch=x86-64-v3", "default")))
 #else

@@ -58,8 +58,8 @@ TEST(Npy, ReadsFloat64AndVersion2) {
 // null buffer to memcpy); as an image it has no pixels.
 TEST(Npy, ZeroExtentGivesAnEmptyArray) {
   const std::string path = scratch("empty.npy");
-  write_text(path, npy_file(1, "{'descr': '<f4', 'fortran_order': False, 'shape': (0, 3, 4), }\n",
-                            ""));
+  write_text(path,
+             npy_file(1, "{'descr': '<f4', 'fortran_order': False, 'shape': (0, 3, 4), }\n", ""));
   const NpyArray array = read_npy(path);
   EXPECT_EQ(array.shape, (std::vector<std::size_t>{0, 3, 4}));
   EXPECT_TRUE(array.values.empty());
