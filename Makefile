@@ -6,8 +6,9 @@ PREFIX ?= /usr/local
 BUILD := build/release
 GLINT := $(BUILD)/apps/glint/glint
 DATA ?= $(or $(GLINT_DATA),../shared/data)
+FUZZ_SECONDS ?= 60
 
-.PHONY: deps build install package demo test bench asan format-check clean
+.PHONY: deps build install package demo test bench asan fuzz format-check clean
 
 deps:
 	bash scripts/install-deps.sh
@@ -35,6 +36,14 @@ asan: deps
 	cmake --preset asan
 	cmake --build --preset asan -j $(JOBS)
 	ctest --preset asan -j $(JOBS)
+
+# Each libFuzzer target of fuzz/ for FUZZ_SECONDS, one after the other (docs/fuzzing.md); finds
+# go to build/fuzz/crashes/.
+fuzz:
+	bash scripts/install-deps.sh --fuzz
+	cmake --preset fuzz
+	cmake --build --preset fuzz -j $(JOBS)
+	bash scripts/fuzz.sh build/fuzz $(FUZZ_SECONDS)
 
 format-check:
 	git ls-files '*.h' '*.cpp' | xargs clang-format --dry-run --Werror

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package glint's build needs (idempotent: only what is missing).
-# Usage: scripts/install-deps.sh [--peers]   (--peers adds the comparison-only libraries for bench/)
+# Usage: scripts/install-deps.sh [--peers | --fuzz]
+#   --peers adds the comparison-only libraries for bench/, --fuzz the compiler and runtime of
+#   `make fuzz` (clang 14 with libFuzzer and the sanitizer runtimes; make test does not need them).
 # Blender (scripts/blender-render-glb.py, a benchmark step) is not installed here:
 # apt-get install blender.
 set -euo pipefail
@@ -34,6 +36,9 @@ packages=(
 if [[ "${1:-}" == "--peers" ]]; then
   # libopenmpi-dev: Debian's PCL loads VTK, whose CMake package needs MPI's C target.
   packages+=(libopen3d-dev libpcl-dev libcgal-dev libopenmpi-dev)
+fi
+if [[ "${1:-}" == "--fuzz" ]]; then
+  packages+=(clang-14 libfuzzer-14-dev libclang-rt-14-dev)
 fi
 
 missing=()

@@ -11,6 +11,7 @@
 #include <numbers>
 #include <vector>
 
+#include "core/cpu_level.h"
 #include "fusion/vector_lanes.h"
 
 namespace glint::fusion {
@@ -184,7 +185,7 @@ using RangeKernel = void (*)(const Association&, std::size_t, std::size_t, Norma
 
 RangeKernel range_kernel() {
 #if defined(__x86_64__)
-  if (__builtin_cpu_supports("x86-64-v3")) return associate_range_x86_64_v3;
+  if (cpu_has_x86_64_v3()) return associate_range_x86_64_v3;
 #endif
   return associate_range_baseline;
 }

@@ -12,6 +12,7 @@
 #include <immintrin.h>
 #endif
 
+#include "core/cpu_level.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "fusion/integrate_frame.h"
@@ -271,8 +272,8 @@ using BlockKernel = void (*)(const FrameConstants&, const float[3], float*, std:
 
 BlockKernel block_kernel() {
 #if defined(__x86_64__)
-  if (__builtin_cpu_supports("x86-64-v4")) return integrate_block_x86_64_v4;
-  if (__builtin_cpu_supports("x86-64-v3")) return integrate_block_x86_64_v3;
+  if (cpu_has_x86_64_v4()) return integrate_block_x86_64_v4;
+  if (cpu_has_x86_64_v3()) return integrate_block_x86_64_v3;
 #endif
   return integrate_block_baseline;
 }

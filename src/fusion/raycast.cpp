@@ -173,7 +173,14 @@ constexpr int kRaysInFlight = 4;
 // time. Also compiled for x86-64-v3 (one-instruction rounding, fused multiply-adds, so the last
 // bits of a hit differ from the baseline build's). Interleaved rays overlap their chains of
 // dependent loads; the clone pays only with them.
-__attribute__((target_clones("arch=x86-64-v3", "default"), flatten)) void cast_row(
+// clang-14 (the fuzz build) refuses flatten on a multiversioned function; there the inliner
+// decides.
+#if defined(__clang__)
+__attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+__attribute__((target_clones("arch=x86-64-v3", "default"), flatten))
+#endif
+void cast_row(
     int y, const TsdfVolume& volume, const BlockOccupancy& occupancy, const TileDepthRanges& ranges,
     const Intrinsics& intrinsics, const Eigen::Matrix3f& rotation, const Eigen::Vector3f& origin,
     const RaycastOptions& options, SurfaceView& view) {

@@ -604,10 +604,12 @@ PointCloud read_las(const std::string& path) {
     }
   }
   const std::size_t classification_at = h.point_format >= 6 ? 16 : 15;
-  constexpr std::size_t kChunk = 1 << 16;
-  std::vector<std::uint8_t> buffer(kChunk * h.record_length);
-  for (std::size_t first = 0; first < n; first += kChunk) {
-    const std::size_t count = std::min(kChunk, n - first);
+  // About 4 MiB of records per read, and never more than the file holds: a record may be up to
+  // 65535 bytes long, and 2^16 of them made a 4 GiB buffer for a few-kilobyte file.
+  const std::size_t chunk = std::max<std::size_t>(1, (std::size_t(1) << 22) / h.record_length);
+  std::vector<std::uint8_t> buffer(std::min(chunk, n) * h.record_length);
+  for (std::size_t first = 0; first < n; first += chunk) {
+    const std::size_t count = std::min(chunk, n - first);
     reader.read_records(first, count, buffer.data());
     for (std::size_t j = 0; j < count; ++j) {
       const std::uint8_t* record = buffer.data() + j * h.record_length;

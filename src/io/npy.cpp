@@ -84,6 +84,7 @@ NpyArray read_npy(const std::string& path) {
                     " data bytes, the file has " + std::to_string(bytes.size() - data_start));
   array.values.resize(count);
   const char* data = bytes.data() + data_start;
+  if (count == 0) return array;  // a zero extent: no values (and no buffer to copy into)
   if (is_f4) {
     std::memcpy(array.values.data(), data, count * 4);
   } else {

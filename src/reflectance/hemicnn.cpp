@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "core/cpu_level.h"
 #include "core/error.h"
 #include "io/json_fields.h"
 #include "io/json_report.h"
@@ -205,7 +206,7 @@ using BranchKernel = void (*)(const HemiCnn&, const float*, float*, float*, floa
 
 BranchKernel branch_kernel() {
 #if defined(__x86_64__)
-  if (__builtin_cpu_supports("x86-64-v3")) return run_branch_x86_64_v3;
+  if (cpu_has_x86_64_v3()) return run_branch_x86_64_v3;
 #endif
   return run_branch_baseline;
 }

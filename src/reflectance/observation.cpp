@@ -9,6 +9,8 @@
 #include <immintrin.h>
 #endif
 
+#include "core/cpu_level.h"
+
 namespace glint::reflectance {
 
 std::uint16_t half_from_float(float value) {
@@ -297,8 +299,8 @@ InsertKernel kernel_of(InsertionKernel kernel) {
 std::vector<InsertionKernel> supported_insertion_kernels() {
   std::vector<InsertionKernel> kernels{InsertionKernel::kScalar};
 #if defined(__x86_64__)
-  if (__builtin_cpu_supports("x86-64-v3")) kernels.push_back(InsertionKernel::kAvx2);
-  if (__builtin_cpu_supports("x86-64-v4")) kernels.push_back(InsertionKernel::kAvx512);
+  if (cpu_has_x86_64_v3()) kernels.push_back(InsertionKernel::kAvx2);
+  if (cpu_has_x86_64_v4()) kernels.push_back(InsertionKernel::kAvx512);
 #endif
   return kernels;
 }

@@ -54,6 +54,18 @@ TEST(Npy, ReadsFloat64AndVersion2) {
   EXPECT_EQ(array.values, (std::vector<float>{0.5f, -1.f, 2.f}));
 }
 
+// A zero extent is a valid empty array (fuzz/corpus/npy/regression-zero-extent once passed a
+// null buffer to memcpy); as an image it has no pixels.
+TEST(Npy, ZeroExtentGivesAnEmptyArray) {
+  const std::string path = scratch("empty.npy");
+  write_text(path,
+             npy_file(1, "{'descr': '<f4', 'fortran_order': False, 'shape': (0, 3, 4), }\n", ""));
+  const NpyArray array = read_npy(path);
+  EXPECT_EQ(array.shape, (std::vector<std::size_t>{0, 3, 4}));
+  EXPECT_TRUE(array.values.empty());
+  EXPECT_THAT(error_of([&] { read_image(path); }).reason(), HasSubstr("pixels"));
+}
+
 TEST(Npy, MalformedFilesNameTheProblem) {
   const std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 2), }\n";
   const std::string truncated = scratch("truncated.npy");
