@@ -47,8 +47,8 @@ struct LightTransportParams {
   int shadow_refresh_frames = 16;
   int indirect_rays = 64;  // n of the estimate
   // While a voxel has fewer than indirect_rays: this many rays every indirect_every_frames
-  // frames it is seen (staggered over the voxels); the gather was 10x the observation stage's
-  // time with 2 rays every frame (bunnies, 2 cm).
+  // frames it is seen (staggered over the voxels), which keeps the gather within a few times
+  // the observation stage's cost (docs/benchmarks.md).
   int indirect_rays_per_frame = 2;
   int indirect_every_frames = 4;
   int indirect_refresh_frames = 16;  // afterwards one ray every this many frames it is seen
