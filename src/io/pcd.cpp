@@ -311,9 +311,11 @@ class PcdBody {
   std::size_t record_values_ = 0;
 };
 
-// The columns being filled: positions in the cloud, colours and other attributes beside it.
+// The columns being filled: positions in double (re-centred when the cloud is assembled),
+// colours and other attributes beside them.
 struct Columns {
   PointCloud cloud;
+  std::vector<double> x, y, z;
   std::vector<std::uint8_t> red, green, blue;
   std::vector<std::optional<AttributeColumn>> attributes;  // per field, for Role::attribute
 };
@@ -322,6 +324,9 @@ Columns make_columns(const std::vector<Field>& fields, const std::vector<Role>& 
                      std::size_t n) {
   Columns columns;
   columns.cloud.resize(n);
+  columns.x.resize(n);
+  columns.y.resize(n);
+  columns.z.resize(n);
   columns.attributes.resize(fields.size());
   for (std::size_t f = 0; f < fields.size(); ++f) {
     if (roles[f] == Role::attribute) columns.attributes[f] = make_column(scalar_of(fields[f]), n);
@@ -334,29 +339,26 @@ Columns make_columns(const std::vector<Field>& fields, const std::vector<Role>& 
   return columns;
 }
 
-// NaN coordinates are kept (the point is dropped later); others must fit a float.
-float coordinate(PcdBody& body, double value, std::size_t point) {
+// NaN coordinates are kept (the point is dropped later); infinite ones are an error. Whether
+// the others fit a float is decided after re-centring (set_positions).
+double coordinate(PcdBody& body, double value, std::size_t point) {
   if (std::isinf(value)) body.fail(point, "non-finite coordinate");
-  if (!fits(Scalar::float32, value)) {
-    body.fail(point, fmt::format("coordinate {} is outside the float range", value));
-  }
-  return static_cast<float>(value);
+  return value;
 }
 
 void read_point(PcdBody& body, const std::vector<Field>& fields, const std::vector<Role>& roles,
                 Columns& columns, std::size_t i) {
-  PointCloud& cloud = columns.cloud;
   for (std::size_t f = 0; f < fields.size(); ++f) {
     const Field& field = fields[f];
     switch (roles[f]) {
       case Role::x:
-        cloud.x[i] = coordinate(body, body.value(field, i), i);
+        columns.x[i] = coordinate(body, body.value(field, i), i);
         break;
       case Role::y:
-        cloud.y[i] = coordinate(body, body.value(field, i), i);
+        columns.y[i] = coordinate(body, body.value(field, i), i);
         break;
       case Role::z:
-        cloud.z[i] = coordinate(body, body.value(field, i), i);
+        columns.z[i] = coordinate(body, body.value(field, i), i);
         break;
       case Role::rgb: {
         const std::uint32_t packed = body.packed(field, i);
@@ -380,7 +382,7 @@ void read_point(PcdBody& body, const std::vector<Field>& fields, const std::vect
   }
 }
 
-PointCloud assemble(Columns columns, const std::vector<Field>& fields) {
+PointCloud assemble(Columns columns, const std::vector<Field>& fields, const std::string& path) {
   PointCloud& cloud = columns.cloud;
   for (std::size_t f = 0; f < fields.size(); ++f) {
     if (columns.attributes[f]) cloud.set(fields[f].name, std::move(*columns.attributes[f]));
@@ -392,10 +394,17 @@ PointCloud assemble(Columns columns, const std::vector<Field>& fields) {
   }
   // Organised clouds mark missing returns with NaN coordinates: drop those points.
   std::vector<bool> valid(cloud.size());
+  std::vector<double> x, y, z;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    valid[i] = !std::isnan(cloud.x[i]) && !std::isnan(cloud.y[i]) && !std::isnan(cloud.z[i]);
+    valid[i] = !std::isnan(columns.x[i]) && !std::isnan(columns.y[i]) && !std::isnan(columns.z[i]);
+    if (!valid[i]) continue;
+    x.push_back(columns.x[i]);
+    y.push_back(columns.y[i]);
+    z.push_back(columns.z[i]);
   }
-  return std::ranges::find(valid, false) == valid.end() ? std::move(cloud) : cloud.select(valid);
+  if (std::ranges::find(valid, false) != valid.end()) cloud = cloud.select(valid);
+  set_positions(cloud, x.data(), y.data(), z.data(), x.size(), path);
+  return std::move(cloud);
 }
 
 }  // namespace
@@ -416,7 +425,7 @@ PointCloud read_pcd(const std::string& path) {
     if (i == allocated) body.truncated(i);
     read_point(body, header.fields, roles, columns, i);
   }
-  return assemble(std::move(columns), header.fields);
+  return assemble(std::move(columns), header.fields, path);
 }
 
 }  // namespace glint::io

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include "io/pcd.h"
 #include "io/ply.h"
 #include "io/text_cloud.h"
 #include "io_test_support.h"
@@ -53,6 +54,28 @@ TEST(Recentring, FarCloudGetsTheFloatsOfTheSameCloudAtZero) {
   }
   // In float the same file loses everything below 1 m.
   EXPECT_NE(float(points[1].x() + offset.x()) - float(offset.x()), float(points[1].x()));
+}
+
+TEST(Recentring, FarPcdCloudIsRecentredAndItsNanPointsDropped) {
+  const std::vector<Eigen::Vector3d> points = grid_points();
+  const Eigen::Vector3d offset(-2e6, 7e6, 3e5);
+  std::string text = fmt::format(
+      "VERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH {}\nHEIGHT 1\n"
+      "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS {}\nDATA ascii\nnan nan nan\n",
+      points.size() + 1, points.size() + 1);
+  for (const Eigen::Vector3d& p : points) {
+    const Eigen::Vector3d q = p + offset;
+    text += fmt::format("{:.17g} {:.17g} {:.17g}\n", q.x(), q.y(), q.z());
+  }
+  const std::string far_path = scratch("far.pcd"), near_path = scratch("near.ply");
+  test::write_text(far_path, text);
+  test::write_text(near_path, ply_text(points, Eigen::Vector3d::Zero()));
+  const PointCloud far = read_pcd(far_path);
+  const PointCloud near = read_ply(near_path);
+  EXPECT_EQ(far.origin, offset);
+  EXPECT_EQ(far.x, near.x);
+  EXPECT_EQ(far.y, near.y);
+  EXPECT_EQ(far.z, near.z);
 }
 
 TEST(Recentring, WritersGiveTheOriginalCoordinatesBack) {
