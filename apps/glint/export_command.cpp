@@ -24,6 +24,21 @@ void add_scene_export_options(CLI::App* command, SceneExportOptions& options) {
                    "scene; 0 = no texture, per-vertex COLOR_0 instead)")
       ->check(kNonNegative)
       ->capture_default_str();
+  command->add_flag("--denoise-albedo", options.params.denoise_albedo,
+                    "scene.glb: denoise the kd atlas where its voxels were seen few times "
+                    "(guided DIP on the atlas at one texel per observation voxel, guided by the "
+                    "local noise level and the observation count; minutes on a CPU)");
+  command
+      ->add_option("--denoise-config", options.params.denoise.config,
+                   "scene.glb, --denoise-albedo: the guided DIP's configuration (fast: sized "
+                   "for a CPU; full: the paper's, a GPU job)")
+      ->check(CLI::IsMember({"fast", "full"}))
+      ->capture_default_str();
+  command
+      ->add_option("--denoise-iterations", options.params.denoise.iterations,
+                   "scene.glb, --denoise-albedo: the guided DIP's steps (default: the "
+                   "configuration's, 1200 for fast)")
+      ->check(CLI::PositiveNumber);
   command
       ->add_option("--up", options.up,
                    "scene.glb: the axis of glint's world that points up (+y for glint's "
@@ -57,6 +72,14 @@ nlohmann::json export_scene(const std::string& folder, const std::string& path,
       "{:.0f} texels/m, {:.1f} MB in {:.1f} s",
       stats.triangles, stats.input_triangles, 1e3 * stats.simplification_error_m, stats.materials,
       stats.lights, stats.charts, stats.texels_per_metre, bytes / 1e6, seconds);
+  if (stats.albedo.contains("truth"))
+    for (const char* atlas : {"atlas", "denoised"})
+      if (stats.albedo["truth"].contains(atlas)) {
+        const nlohmann::json& errors = stats.albedo["truth"][atlas];
+        log().info("kd {} against the truth: L1 {:.4f} (well observed {:.4f}, poorly {:.4f})",
+                   atlas, errors["all"].value("l1", 0.0), errors["well_observed"].value("l1", 0.0),
+                   errors["poorly_observed"].value("l1", 0.0));
+      }
   nlohmann::json report = stats.to_json();
   report["total_s"] = seconds;
   report["bytes"] = bytes;
@@ -88,6 +111,12 @@ void register_export_command(CLI::App& app) {
       ->required()
       ->check(kOutputFile);
   add_scene_export_options(command, options->scene);
+  command
+      ->add_option("--albedo-truth", options->scene.params.albedo_truth,
+                   "A synthetic sequence (glint render) the reconstruction came from: report the "
+                   "kd atlas's L1 / PSNR against its ground truth, for well-observed (>= 15 "
+                   "observations) and poorly observed texels, with and without --denoise-albedo")
+      ->check(CLI::ExistingDirectory);
   command->add_option("--report", options->report, "JSON report: counts, sizes, seconds")
       ->check(kOutputFile);
   command->footer(
@@ -95,6 +124,7 @@ void register_export_command(CLI::App& app) {
       "  glint export out/bunnies -o bunnies.glb\n"
       "  glint export out/kitchen -o kitchen.glb --up -y --mesh-triangles 100000\n"
       "  glint export out/office -o office-full.glb --mesh-triangles 0 --texture-size 4096\n"
+      "  glint export out/bunnies -o bunnies.glb --denoise-albedo --albedo-truth seq/bunnies\n"
       "Check a file: node scripts/validate-glb.cjs X.glb (the Khronos glTF-Validator; see\n"
       "docs/reflectance.md, Export).");
   command->callback([options] {

@@ -12,7 +12,8 @@ struct SceneExportOptions {
   std::string up = "+y";
 };
 
-// Adds --mesh-triangles, --texture-size and --up to `command`.
+// Adds --mesh-triangles, --texture-size, --denoise-albedo, --denoise-config and --up to
+// `command`.
 void add_scene_export_options(CLI::App* command, SceneExportOptions& options);
 // The parameters with --up parsed (throws glint::Error for an unknown axis).
 gltf::ExportParams scene_export_params(const SceneExportOptions& options);

@@ -8,10 +8,13 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
+#include "core/log.h"
 #include "core/parallel.h"
 #include "core/timer.h"
 #include "fusion/triangle_mesh.h"
 #include "geometry/kdtree.h"
+#include "gltf/albedo_denoising.h"
+#include "gltf/albedo_truth.h"
 #include "gltf/material_conversion.h"
 #include "gltf/texture_atlas.h"
 #include "io/json_report.h"
@@ -25,6 +28,9 @@ namespace fs = std::filesystem;
 constexpr int kLinear = 9729, kClampToEdge = 33071;
 // The atlas samples the full-resolution mesh: the refined kd of its nearest vertices.
 constexpr int kAtlasNeighbours = 8;
+// The atlas's errors against the truth split texels at half a voxel's observation capacity
+// (m = 30): at least 15 observations is "well observed".
+constexpr float kWellObserved = 15;
 
 const std::vector<float>& float_column(const PointCloud& cloud, const char* name,
                                        const std::string& path) {
@@ -89,6 +95,7 @@ std::vector<Eigen::Vector3f> vertex_normals(const std::vector<Eigen::Vector3f>& 
 // The kd at a surface point: inverse-distance mean of the nearest full-resolution vertices of
 // the triangle's segment that carry a material (each is the trilinear refined kd at that
 // vertex, reflectance/material_maps.h); of any vertex with one when none of the segment is near.
+// Likewise the observation count, over the nearest vertices of any segment.
 class AlbedoSampler {
  public:
   explicit AlbedoSampler(const Reconstruction& scene) : scene_(scene) {
@@ -96,7 +103,7 @@ class AlbedoSampler {
     for (const Eigen::Vector3f& v : scene.vertices) cloud_.push_back(v.x(), v.y(), v.z());
     tree_ = std::make_unique<geometry::KdTree>(cloud_);
   }
-  Eigen::Vector3f operator()(const Eigen::Vector3f& p, int segment) const {
+  Eigen::Vector3f kd(const Eigen::Vector3f& p, int segment) const {
     std::uint32_t index[kAtlasNeighbours];
     float d2[kAtlasNeighbours];
     const int found = tree_->knn(p.data(), kAtlasNeighbours, index, d2);
@@ -107,7 +114,7 @@ class AlbedoSampler {
         const std::uint32_t v = index[k];
         if (scene_.segment[v] <= 0 || scene_.kd[v].isZero()) continue;
         if (same_segment && scene_.segment[v] != segment) continue;
-        const float w = 1.0f / (std::sqrt(d2[k]) + 1e-4f);
+        const float w = inverse_distance(d2[k]);
         sum += w * scene_.kd[v];
         weight += w;
       }
@@ -115,12 +122,68 @@ class AlbedoSampler {
     }
     return Eigen::Vector3f::Zero();
   }
+  float observations(const Eigen::Vector3f& p) const {
+    std::uint32_t index[kAtlasNeighbours];
+    float d2[kAtlasNeighbours];
+    const int found = tree_->knn(p.data(), kAtlasNeighbours, index, d2);
+    float sum = 0, weight = 0;
+    for (int k = 0; k < found; ++k) {
+      sum += inverse_distance(d2[k]) * scene_.observations[index[k]];
+      weight += inverse_distance(d2[k]);
+    }
+    return weight > 0 ? sum / weight : 0.0f;
+  }
 
  private:
+  static float inverse_distance(float d2) { return 1.0f / (std::sqrt(d2) + 1e-4f); }
+
   const Reconstruction& scene_;
   PointCloud cloud_;
   std::unique_ptr<geometry::KdTree> tree_;
 };
+
+// --denoise-albedo: `image` (the atlas baked from `kd` over `layout`) is replaced by its
+// denoised bake. --albedo-truth: the errors of the atlas (and of the denoised one) against the
+// truth, split by observation count. Both go to stats.albedo.
+void denoise_and_evaluate(const Reconstruction& scene,
+                          const std::vector<Eigen::Vector3i>& triangles,
+                          const std::vector<int>& segment_of, const ExportParams& params,
+                          const AlbedoSampler& sampler, const SurfaceSampler& kd,
+                          AtlasLayout& layout, const std::vector<std::uint8_t>& baked,
+                          ImageF& image, ExportStats& stats) {
+  if (scene.observations.empty())
+    throw Error("mesh.ply", "observations",
+                "missing vertex property (a reconstruction from an older glint); run glint "
+                "reconstruct again to denoise or evaluate the albedo atlas");
+  const AtlasParams atlas{.size = params.texture_size};
+  const SurfaceSampler observations = [&](const Eigen::Vector3f& p, int) {
+    return Eigen::Vector3f(sampler.observations(p), 0, 0);
+  };
+  const ImageF counts = bake_atlas(layout, scene.vertices, observations, atlas);
+  const ImageF baked_kd = image;
+  if (params.denoise_albedo) {
+    const AlbedoCorrection correction(
+        scene.vertices, triangles, segment_of, kd, observations,
+        {.settings = params.denoise, .voxel_m = scene.observation_voxel_m});
+    image = bake_atlas(
+        layout, scene.vertices,
+        [&](const Eigen::Vector3f& p, int t) {
+          return Eigen::Vector3f((kd(p, t) + correction(p, t)).cwiseMax(0.0f).cwiseMin(1.0f));
+        },
+        atlas);
+    stats.albedo["denoising"] = correction.stats().to_json();
+  }
+  if (params.albedo_truth.empty()) return;
+  const AlbedoTruth truth(params.albedo_truth);
+  const ImageF true_kd = bake_atlas(
+      layout, scene.vertices, [&](const Eigen::Vector3f& p, int) { return truth(p); }, atlas);
+  nlohmann::json& report = stats.albedo["truth"];
+  report["sequence"] = params.albedo_truth;
+  report["views"] = truth.views();
+  report["atlas"] = albedo_errors(baked_kd, true_kd, counts, baked, kWellObserved);
+  if (params.denoise_albedo)
+    report["denoised"] = albedo_errors(image, true_kd, counts, baked, kWellObserved);
+}
 
 std::vector<std::uint8_t> encode_srgb_png(const ImageF& image) {
   cv::Mat bgr(image.height(), image.width(), CV_8UC3);
@@ -216,6 +279,8 @@ Reconstruction read_reconstruction(const std::string& folder) {
   const std::vector<float>& g = float_column(v, "kd_g", mesh_path);
   const std::vector<float>& b = float_column(v, "kd_b", mesh_path);
   const std::vector<float>& segment = float_column(v, "scalar_segment", mesh_path);
+  if (const std::vector<float>* observations = v.get<float>("observations"))
+    scene.observations = *observations;
   scene.vertices.resize(v.size());
   scene.kd.resize(v.size());
   scene.segment.resize(v.size());
@@ -226,6 +291,12 @@ Reconstruction read_reconstruction(const std::string& folder) {
   }
   scene.triangles = std::move(mesh.triangles);
   scene.materials = io::read_json(materials_path);
+  if (scene.materials.contains("observation_voxel_m")) {
+    const nlohmann::json& size = scene.materials.at("observation_voxel_m");
+    if (!size.is_number() || !(size.get<float>() > 0))
+      throw Error(materials_path, "observation_voxel_m", "must be a positive length in metres");
+    scene.observation_voxel_m = size.get<float>();
+  }
   scene.lights = reflectance::read_lights_json(lights_path);
   return scene;
 }
@@ -246,6 +317,7 @@ nlohmann::json ExportStats::to_json() const {
   nlohmann::json json = counts_json();
   json["seconds"] = {
       {"simplify", simplify_s}, {"layout", layout_s}, {"bake", bake_s}, {"png", png_s}};
+  if (!albedo.is_null()) json["albedo"] = albedo;
   return json;
 }
 
@@ -276,10 +348,15 @@ GlbBuilder build_scene_glb(const Reconstruction& scene, const ExportParams& para
     stats.layout_s = watch.elapsed_s();
     watch.restart();
     const AlbedoSampler sampler(scene);
-    const ImageF image = bake_atlas(
-        layout, scene.vertices,
-        [&](const Eigen::Vector3f& p, int t) { return sampler(p, segment_of[t]); }, atlas);
+    const SurfaceSampler kd = [&](const Eigen::Vector3f& p, int t) {
+      return sampler.kd(p, segment_of[t]);
+    };
+    std::vector<std::uint8_t> baked;
+    ImageF image = bake_atlas(layout, scene.vertices, kd, atlas, &baked);
     stats.bake_s = watch.elapsed_s();
+    if (params.denoise_albedo || !params.albedo_truth.empty())
+      denoise_and_evaluate(scene, triangles, segment_of, params, sampler, kd, layout, baked, image,
+                           stats);
     stats.charts = layout.charts;
     stats.texels_per_metre = layout.texels_per_metre;
     stats.overlapping_texels = layout.overlapping_texels;

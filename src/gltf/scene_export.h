@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "denoise/denoiser.h"
 #include "gltf/glb.h"
 #include "reflectance/light_estimation.h"
 
@@ -32,10 +33,15 @@ struct Reconstruction {
   std::vector<Eigen::Vector3i> triangles;  // counter-clockwise seen from free space
   std::vector<Eigen::Vector3f> kd;         // refined diffuse albedo per vertex, linear
   std::vector<int> segment;                // per vertex, 0 = none
-  nlohmann::json materials;                // materials.json
+  // Per vertex, its observation voxel's stored observations (0-30); empty for reconstructions
+  // written before mesh.ply carried them.
+  std::vector<float> observations;
+  float observation_voxel_m = 0.02f;  // materials.json "observation_voxel_m"
+  nlohmann::json materials;           // materials.json
   reflectance::LightEstimate lights;
 };
-// FOLDER/mesh.ply (kd_r, kd_g, kd_b, scalar_segment per vertex), FOLDER/materials.json and
+// FOLDER/mesh.ply (kd_r, kd_g, kd_b, scalar_segment and, when present, observations per
+// vertex), FOLDER/materials.json and
 // FOLDER/lights.json, as `glint reconstruct` writes them. Throws glint::Error naming the file.
 Reconstruction read_reconstruction(const std::string& folder);
 
@@ -43,6 +49,13 @@ struct ExportParams {
   std::size_t mesh_triangles = 300000;  // simplification budget; 0: full resolution
   int texture_size = 2048;              // kd atlas side, texels; 0: per-vertex COLOR_0 only
   UpAxis up = UpAxis::pos_y;
+  // Guided DIP on the kd atlas (gltf/albedo_denoising.h) with these settings; needs the atlas and
+  // the mesh's observation counts.
+  bool denoise_albedo = false;
+  denoise::DenoiserSettings denoise{};
+  // A synthetic sequence whose ground truth the atlas is measured against (gltf/albedo_truth.h);
+  // empty: none.
+  std::string albedo_truth{};
 };
 
 struct ExportStats {
@@ -53,6 +66,9 @@ struct ExportStats {
   std::size_t overlapping_texels = 0;
   // Seconds per step: simplification, chart layout, baking (kNN sampling and dilation), PNG.
   double simplify_s = 0, layout_s = 0, bake_s = 0, png_s = 0;
+  // Albedo denoising's statistics ("denoising") and the atlas's errors against the truth
+  // ("truth": "atlas", and "denoised" when denoised); null when neither ran.
+  nlohmann::json albedo;
   // The counts alone (what the GLB's extras carry: the same file from the same input) and with
   // the seconds (reports).
   nlohmann::json counts_json() const;

@@ -137,6 +137,7 @@ AtlasLayout layout_atlas(const std::vector<Eigen::Vector3f>& vertices,
   for (const Chart& chart : charts)
     area += double(chart.hi.x() - chart.lo.x()) * (chart.hi.y() - chart.lo.y());
   float density = float(params.size / std::sqrt(std::max(area, 1e-12)));
+  if (params.max_texels_per_metre > 0) density = std::min(density, params.max_texels_per_metre);
   while (!pack(charts, order, density, params)) {
     density *= 0.98f;
     if (density < kMinTexelsPerMetre)
@@ -174,7 +175,8 @@ AtlasLayout layout_atlas(const std::vector<Eigen::Vector3f>& vertices,
 }
 
 ImageF bake_atlas(AtlasLayout& layout, const std::vector<Eigen::Vector3f>& vertices,
-                  const SurfaceSampler& sample, const AtlasParams& params) {
+                  const SurfaceSampler& sample, const AtlasParams& params,
+                  std::vector<std::uint8_t>* baked) {
   const int size = layout.size;
   ImageF image(size, size, 3, 0.0f);
   std::vector<int> owner(std::size_t(size) * size, -1);
@@ -249,34 +251,39 @@ ImageF bake_atlas(AtlasLayout& layout, const std::vector<Eigen::Vector3f>& verti
   });
   layout.overlapping_texels = overlapping;
 
-  // Dilation into the gutters: each pass fills the empty texels beside filled ones with their
-  // mean, reading the previous pass only.
   std::vector<std::uint8_t> filled(owner.size());
   for (std::size_t i = 0; i < owner.size(); ++i) filled[i] = owner[i] >= 0;
+  if (baked) *baked = filled;
+  dilate_atlas(image, filled, params.gutter);
+  return image;
+}
+
+void dilate_atlas(ImageF& image, std::vector<std::uint8_t>& filled, int passes) {
+  const int width = image.width(), height = image.height(), channels = image.channels();
+  if (channels > 4) throw Error("texture atlas", "", "dilation takes at most 4 channels");
   std::vector<std::uint8_t> next = filled;
-  for (int pass = 0; pass < params.gutter; ++pass) {
-    parallel_for(std::size_t(size), [&](std::size_t row) {
+  for (int pass = 0; pass < passes; ++pass) {
+    parallel_for(std::size_t(height), [&](std::size_t row) {
       const int y = int(row);
-      for (int x = 0; x < size; ++x) {
-        if (filled[std::size_t(y) * size + x]) continue;
-        Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+      for (int x = 0; x < width; ++x) {
+        if (filled[std::size_t(y) * width + x]) continue;
+        float sum[4] = {0, 0, 0, 0};
         int count = 0;
         for (int dy = -1; dy <= 1; ++dy)
           for (int dx = -1; dx <= 1; ++dx) {
             const int u = x + dx, v = y + dy;
-            if (u < 0 || v < 0 || u >= size || v >= size || !filled[std::size_t(v) * size + u])
+            if (u < 0 || v < 0 || u >= width || v >= height || !filled[std::size_t(v) * width + u])
               continue;
-            for (int ch = 0; ch < 3; ++ch) sum[ch] += image.at(u, v, ch);
+            for (int ch = 0; ch < channels; ++ch) sum[ch] += image.at(u, v, ch);
             ++count;
           }
         if (count == 0) continue;
-        for (int ch = 0; ch < 3; ++ch) image.at(x, y, ch) = sum[ch] / float(count);
-        next[std::size_t(y) * size + x] = 1;
+        for (int ch = 0; ch < channels; ++ch) image.at(x, y, ch) = sum[ch] / float(count);
+        next[std::size_t(y) * width + x] = 1;
       }
     });
     filled = next;
   }
-  return image;
 }
 
 }  // namespace glint::gltf

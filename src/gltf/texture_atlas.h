@@ -23,6 +23,8 @@ namespace glint::gltf {
 struct AtlasParams {
   int size = 2048;  // texels per side
   int gutter = 1;   // texels around each chart's bounding rectangle (>= 1)
+  // The layout's density is at most this (texels per metre; 0: as dense as `size` allows).
+  float max_texels_per_metre = 0;
 };
 
 struct AtlasLayout {
@@ -54,8 +56,15 @@ using SurfaceSampler = std::function<Eigen::Vector3f(const Eigen::Vector3f& poin
 // The atlas image (3 channels, as the sampler returns them, 0 where no chart is): every texel
 // whose centre lies in a triangle, or within one texel of it, gets sample(nearest point of the
 // triangle); then `params.gutter` dilation passes give each empty texel next to baked ones their
-// mean (8-neighbourhood). Also fills `layout.overlapping_texels`.
+// mean (8-neighbourhood). Also fills `layout.overlapping_texels` and, when given, `baked`: 1 for
+// the texels baked from a triangle, 0 for the gutter and empty ones (size² entries, row-major).
 ImageF bake_atlas(AtlasLayout& layout, const std::vector<Eigen::Vector3f>& vertices,
-                  const SurfaceSampler& sample, const AtlasParams& params = {});
+                  const SurfaceSampler& sample, const AtlasParams& params = {},
+                  std::vector<std::uint8_t>* baked = nullptr);
+
+// `passes` dilation passes over `image`: each fills the empty texels (filled[i] == 0) beside
+// filled ones with their mean (8-neighbourhood), reading the previous pass only, and marks them
+// filled. At most 4 channels.
+void dilate_atlas(ImageF& image, std::vector<std::uint8_t>& filled, int passes);
 
 }  // namespace glint::gltf

@@ -156,11 +156,16 @@ Image<std::int32_t> read_ground_truth_segments(const io::RgbdSequence& sequence,
   return ids;
 }
 
+ImageF read_ground_truth_map(const io::RgbdSequence& sequence, std::size_t i,
+                             const std::string& kind, int channels) {
+  return read_checked(ground_truth_path(sequence, i, kind, ".exr"), channels);
+}
+
 GroundTruthMaps read_ground_truth_maps(const io::RgbdSequence& sequence, std::size_t i) {
   GroundTruthMaps maps;
-  maps.kd = read_checked(ground_truth_path(sequence, i, "kd", ".exr"), 3);
-  maps.ks = read_checked(ground_truth_path(sequence, i, "ks", ".exr"), 3);
-  maps.alpha = read_checked(ground_truth_path(sequence, i, "alpha", ".exr"), 1);
+  maps.kd = read_ground_truth_map(sequence, i, "kd", 3);
+  maps.ks = read_ground_truth_map(sequence, i, "ks", 3);
+  maps.alpha = read_ground_truth_map(sequence, i, "alpha", 1);
   maps.segment = read_ground_truth_segments(sequence, i);
   return maps;
 }

@@ -40,6 +40,10 @@ bool has_ground_truth_maps(const io::RgbdSequence& sequence);
 GroundTruthMaps read_ground_truth_maps(const io::RgbdSequence& sequence, std::size_t i);
 // gt/segment of frame i only.
 Image<std::int32_t> read_ground_truth_segments(const io::RgbdSequence& sequence, std::size_t i);
+// gt/<kind>/<frame>.exr of frame i (kind: kd, ks, alpha, depth, normal), checked to have
+// `channels` channels. Throws glint::Error naming the file.
+ImageF read_ground_truth_map(const io::RgbdSequence& sequence, std::size_t i,
+                             const std::string& kind, int channels);
 
 enum class Quantity { kd, kd_refined, ks, alpha, rgb, rgb_refined };
 inline constexpr std::array<Quantity, 6> kQuantities{Quantity::kd,  Quantity::kd_refined,

@@ -59,14 +59,18 @@ void render_model(const ReflectancePipeline& pipeline, const Intrinsics& intrins
 fusion::TriangleMesh material_mesh(const ReflectancePipeline& pipeline) {
   fusion::TriangleMesh mesh = fusion::extract_mesh(pipeline.geometry());
   const std::size_t n = mesh.vertices.size();
-  std::array<std::vector<float>, 8> values;  // kd rgb, ks rgb, alpha, segment
+  std::array<std::vector<float>, 9> values;  // kd rgb, ks rgb, alpha, segment, observations
   for (auto& v : values) v.assign(n, 0.0f);
   mesh.colours.assign(n, Eigen::Vector3f::Zero());
   // Chunks of consecutive vertices (marching cubes emits them block by block), so that each
   // lookup mostly finds its neighbourhood kept from the vertex before.
   parallel_for_chunks(n, 1024, [&](std::size_t begin, std::size_t end) {
-    MaterialLookup lookup(pipeline.observations(), pipeline.materials(), pipeline.albedo_blend());
+    const ObservationGrid& grid = pipeline.observations();
+    MaterialLookup lookup(grid, pipeline.materials(), pipeline.albedo_blend());
+    ObservationGrid::BlockCache blocks;
     for (std::size_t i = begin; i < end; ++i) {
+      const int voxel = grid.find(mesh.vertices[i], &blocks);
+      values[8][i] = voxel >= 0 ? float(grid.observation_count(voxel)) : 0.0f;
       PointMaterial material;
       const bool with_material = lookup(mesh.vertices[i], material);
       values[7][i] = float(material.segment);
@@ -79,13 +83,14 @@ fusion::TriangleMesh material_mesh(const ReflectancePipeline& pipeline) {
       values[6][i] = material.fused.alpha;
     }
   });
-  const std::array<const char*, 8> names{"kd_r", "kd_g", "kd_b",  "ks_r",
-                                         "ks_g", "ks_b", "alpha", "scalar_segment"};
-  for (int k = 0; k < 8; ++k) mesh.vertex_properties.emplace_back(names[k], std::move(values[k]));
+  const std::array<const char*, 9> names{"kd_r", "kd_g",  "kd_b",           "ks_r",        "ks_g",
+                                         "ks_b", "alpha", "scalar_segment", "observations"};
+  for (int k = 0; k < 9; ++k) mesh.vertex_properties.emplace_back(names[k], std::move(values[k]));
   mesh.comments = {
       "glint reconstruct; red green blue: refined diffuse albedo kd, 8-bit sRGB",
       "kd_*: refined diffuse albedo, ks_*: specular albedo, alpha: Ward roughness (linear)",
-      "scalar_segment: segment id (0 = none); vertices without a material have zeros"};
+      "scalar_segment: segment id (0 = none); vertices without a material have zeros",
+      "observations: stored observations of the vertex's observation voxel (0-30)"};
   return mesh;
 }
 
@@ -147,7 +152,9 @@ nlohmann::json materials_json(const ReflectancePipeline& pipeline) {
     }
     segments.push_back(entry);
   }
-  return {{"segments", segments}, {"exposure", pipeline.exposure()}};
+  return {{"segments", segments},
+          {"exposure", pipeline.exposure()},
+          {"observation_voxel_m", grid.params().voxel_size_m}};
 }
 
 void write_materials_json(const std::string& path, const ReflectancePipeline& pipeline) {

@@ -34,14 +34,15 @@ void render_model(const ReflectancePipeline& pipeline, const Intrinsics& intrins
                   MaterialMaps& maps, const ImageF* fused_depth = nullptr);
 
 // Marching-cubes mesh of the geometry; per vertex: the refined kd as colour (linear RGB) and
-// float properties kd_r/g/b (refined), ks_r/g/b, alpha and scalar_segment (0 = none; vertices
-// without a material have zeros).
+// float properties kd_r/g/b (refined), ks_r/g/b, alpha, scalar_segment (0 = none; vertices
+// without a material have zeros) and observations (the stored observations of the observation
+// voxel holding the vertex: what the albedo atlas's denoising is guided by).
 fusion::TriangleMesh material_mesh(const ReflectancePipeline& pipeline);
 // material_mesh() as a binary PLY (colour as 8-bit sRGB), written atomically.
 void write_material_mesh(const std::string& path, const ReflectancePipeline& pipeline);
 
 // Per segment: fused kd, ks, alpha, the latest estimate, estimate count, voxel count and the
-// mean refined kd of its voxels.
+// mean refined kd of its voxels; the exposure and the observation grid's voxel size.
 nlohmann::json materials_json(const ReflectancePipeline& pipeline);
 void write_materials_json(const std::string& path, const ReflectancePipeline& pipeline);
 

@@ -14,6 +14,7 @@
 #include "fusion/triangle_mesh.h"
 #include "gltf/material_conversion.h"
 #include "io/json_report.h"
+#include "render/sensor.h"
 #include "support/cli_fixture.h"
 
 namespace glint::gltf {
@@ -224,6 +225,8 @@ class SceneExportFiles : public CliTest {
     }
     const char* names[] = {"kd_r", "kd_g", "kd_b", "scalar_segment"};
     for (int k = 0; k < 4; ++k) mesh.vertex_properties.emplace_back(names[k], columns[k]);
+    if (!scene.observations.empty())
+      mesh.vertex_properties.emplace_back("observations", scene.observations);
     fusion::write_mesh_ply(folder + "/mesh.ply", mesh);
     io::write_json(folder + "/materials.json", scene.materials);
     reflectance::write_lights_json(folder + "/lights.json", scene.lights);
@@ -239,6 +242,8 @@ TEST_F(SceneExportFiles, FolderReadsBackAsWritten) {
   EXPECT_EQ(read.segment, scene.segment);
   EXPECT_TRUE(read.kd[3].isApprox(scene.kd[3]));
   EXPECT_EQ(read.lights.lights.size(), 1u);
+  EXPECT_TRUE(read.observations.empty());  // an older reconstruction's mesh
+  EXPECT_FLOAT_EQ(read.observation_voxel_m, 0.02f);
   EXPECT_EQ(build_scene_glb(read, {.texture_size = 64}).bytes(),
             build_scene_glb(scene, {.texture_size = 64}).bytes());
 }
@@ -298,6 +303,81 @@ TEST_F(SceneExportFiles, ExportCommandWritesTheGlbAndReport) {
   EXPECT_NE(bad.exit_code, 0);
   EXPECT_NE(bad.output.find("--up"), std::string::npos) << bad.output;
   EXPECT_FALSE(fs::exists(path("x.glb")));
+}
+
+// A 0.8 m square of 2 cm quads with kd 0.5: its left half seen 30 times (kd within 0.005), its
+// right half twice (kd off by up to 0.3, per vertex).
+Reconstruction half_observed_plane() {
+  Reconstruction scene;
+  const int n = 40;
+  std::uint32_t state = 12345;
+  const auto uniform = [&state] {  // a fixed sequence in [-1, 1]
+    state = state * 1664525u + 1013904223u;
+    return float(state >> 8) / float(1 << 23) - 1.0f;
+  };
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      scene.vertices.push_back({0.02f * float(i), 0.02f * float(j), 0});
+      const bool well = i < n / 2;
+      scene.kd.push_back(Eigen::Vector3f::Constant(0.5f + (well ? 0.005f : 0.3f) * uniform()));
+      scene.segment.push_back(1);
+      scene.observations.push_back(well ? 30.0f : 2.0f);
+    }
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i, b = a + 1, c = a + n + 1, d = c + 1;
+      scene.triangles.push_back({a, b, d});
+      scene.triangles.push_back({a, d, c});
+    }
+  scene.materials = {
+      {"exposure", 1.0}, {"observation_voxel_m", 0.02}, {"segments", nlohmann::json::array()}};
+  return scene;
+}
+
+// Mean |kd - 0.5| over the atlas's non-empty texels (linear).
+double mean_deviation(const Glb& glb) {
+  const nlohmann::json& doc = glb.document;
+  const nlohmann::json& view = doc["bufferViews"][int(doc["images"][0]["bufferView"])];
+  const std::vector<std::uint8_t> png(
+      glb.bin.begin() + int(view["byteOffset"]),
+      glb.bin.begin() + int(view["byteOffset"]) + int(view["byteLength"]));
+  const cv::Mat image = cv::imdecode(png, cv::IMREAD_COLOR);
+  double sum = 0;
+  int count = 0;
+  for (int y = 0; y < image.rows; ++y)
+    for (int x = 0; x < image.cols; ++x) {
+      const cv::Vec3b bgr = image.at<cv::Vec3b>(y, x);
+      if (bgr[1] == 0) continue;
+      sum += std::abs(render::srgb_to_linear(bgr[1] / 255.0f) - 0.5);
+      ++count;
+    }
+  return count > 0 ? sum / count : 1.0;
+}
+
+TEST(SceneExport, DenoisingTheAlbedoNeedsTheObservationCounts) {
+  try {
+    build_scene_glb(cube_scene(), {.texture_size = 64, .denoise_albedo = true});
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.element(), "observations");
+  }
+}
+
+TEST_F(SceneExportFiles, DenoisedAlbedoIsCloserToTheTruthWhereItWasSeenRarely) {
+  const std::string folder = write_folder(half_observed_plane());
+  const std::string common = "export " + folder + " --mesh-triangles 0 --texture-size 128";
+  const CommandResult plain = glint(common + " -o " + path("plain.glb"));
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  const CommandResult denoised = glint(common + " --denoise-albedo --denoise-iterations 300 -o " +
+                                       path("denoised.glb") + " --report " + path("r.json"));
+  ASSERT_EQ(denoised.exit_code, 0) << denoised.output;
+  const double before = mean_deviation(read_glb(path("plain.glb")));
+  const double after = mean_deviation(read_glb(path("denoised.glb")));
+  EXPECT_GT(before, 0.02);
+  EXPECT_LT(after, before);
+  const nlohmann::json report = io::read_json(path("r.json"));
+  EXPECT_EQ(report["albedo"]["denoising"]["iterations"], 300);
+  EXPECT_FLOAT_EQ(report["albedo"]["denoising"]["texels_per_metre"].get<float>(), 50.0f);
 }
 
 }  // namespace
