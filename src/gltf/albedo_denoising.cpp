@@ -15,6 +15,12 @@ namespace {
 // noise level's 7x7 patches and the U-Net's convolutions at a chart's border see a continuation
 // of the chart rather than a step to zero.
 constexpr int kFillPasses = 8;
+// Guided DIP's fast configuration was sized on 256x256 images. Its cost per pixel rises about
+// tenfold from there to an 816x721 image (0.86 us per pixel and step at 256^2 and 384^2, 8.5 at
+// 816x721 on 2 cores: the activations leave the caches), so larger atlases are denoised in
+// tiles of this side, overlapping by kTileOverlap texels and blended linearly there.
+constexpr int kTile = 256;
+constexpr int kTileOverlap = 32;
 // Retries of the low-resolution layout, each 20 % larger, when the first size is too small for
 // the charts at the observation grid's density.
 constexpr int kLayoutAttempts = 12;
@@ -82,6 +88,68 @@ std::vector<std::uint8_t> crop(const std::vector<std::uint8_t>& mask, int size, 
   return out;
 }
 
+// Tile origins along an axis of `length` texels: tiles of kTile (or the whole axis), evenly
+// spread, neighbours overlapping by at least kTileOverlap.
+std::vector<int> tile_origins(int length) {
+  if (length <= kTile) return {0};
+  const int tiles = (length - kTileOverlap + kTile - kTileOverlap - 1) / (kTile - kTileOverlap);
+  std::vector<int> origins;
+  for (int i = 0; i < tiles; ++i)
+    origins.push_back(int(std::lround(double(i) * (length - kTile) / (tiles - 1))));
+  return origins;
+}
+
+// A tile's blending weight along one axis at `position`: a ramp over the overlap on each side
+// that has a neighbour, 1 elsewhere.
+float ramp(int position, int origin, int size, int length) {
+  float weight = 1;
+  if (origin > 0) weight = std::min(weight, (float(position - origin) + 0.5f) / kTileOverlap);
+  if (origin + size < length)
+    weight = std::min(weight, (float(origin + size - position) - 0.5f) / kTileOverlap);
+  return weight;
+}
+
+// Guided DIP over `noisy` in overlapping tiles; a tile with no guided texel (`guidance` below
+// 1 where `baked`) keeps its input.
+ImageF denoise_tiled(const ImageF& noisy, const ImageF& guidance,
+                     const std::vector<std::uint8_t>& baked,
+                     const denoise::DenoiserSettings& settings, AlbedoDenoiseStats& stats) {
+  const int width = noisy.width(), height = noisy.height();
+  ImageF sum(width, height, 3, 0.0f), weights(width, height, 1, 0.0f);
+  const std::vector<int> xs = tile_origins(width), ys = tile_origins(height);
+  for (const int y0 : ys)
+    for (const int x0 : xs) {
+      const Box box{x0, y0, std::min(width, x0 + kTile), std::min(height, y0 + kTile)};
+      bool guided = false;
+      for (int y = box.y0; y < box.y1 && !guided; ++y)
+        for (int x = box.x0; x < box.x1 && !guided; ++x)
+          guided = baked[std::size_t(y) * width + x] && guidance.at(x, y, 0) < 1.0f;
+      ImageF tile = crop(noisy, box);
+      if (guided) {
+        const ImageF tile_guidance = crop(guidance, box);
+        const denoise::DenoiseRun run =
+            denoise::run_denoiser("guided-dip", settings, tile, &tile_guidance);
+        tile = run.result;
+        stats.seconds += run.stats.seconds;
+        stats.iterations = run.stats.iterations;
+        stats.device = run.stats.device;
+        ++stats.tiles_denoised;
+      }
+      ++stats.tiles;
+      for (int y = box.y0; y < box.y1; ++y)
+        for (int x = box.x0; x < box.x1; ++x) {
+          const float w =
+              ramp(x, box.x0, box.x1 - box.x0, width) * ramp(y, box.y0, box.y1 - box.y0, height);
+          weights.at(x, y, 0) += w;
+          for (int c = 0; c < 3; ++c) sum.at(x, y, c) += w * tile.at(x - box.x0, y - box.y0, c);
+        }
+    }
+  for (int c = 0; c < 3; ++c)
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) sum.at(x, y, c) /= weights.at(x, y, 0);
+  return sum;
+}
+
 // Barycentric coordinates of p (on or near triangle a, b, c) in that triangle.
 Eigen::Vector3f barycentric(const Eigen::Vector3f& p, const Eigen::Vector3f& a,
                             const Eigen::Vector3f& b, const Eigen::Vector3f& c) {
@@ -100,6 +168,7 @@ nlohmann::json AlbedoDenoiseStats::to_json() const {
   return {{"method", "guided-dip"},   {"width", width},
           {"height", height},         {"texels_per_metre", texels_per_metre},
           {"baked_texels", texels},   {"guided_fraction", guided_fraction},
+          {"tiles", tiles},           {"tiles_denoised", tiles_denoised},
           {"iterations", iterations}, {"device", device},
           {"seconds", seconds}};
 }
@@ -158,11 +227,7 @@ AlbedoCorrection::AlbedoCorrection(const std::vector<Eigen::Vector3f>& vertices,
   if (stats_.texels > 0) stats_.guided_fraction /= double(stats_.texels);
   log().info("kd atlas denoising: {}x{} texels at {:.0f} texels/m, {:.0f} % of them guided",
              noisy.width(), noisy.height(), layout_.texels_per_metre, 100 * stats_.guided_fraction);
-  const denoise::DenoiseRun run =
-      denoise::run_denoiser("guided-dip", params.settings, noisy, &guidance);
-  stats_.seconds = run.stats.seconds;
-  stats_.iterations = run.stats.iterations;
-  stats_.device = run.stats.device;
+  const ImageF denoised = denoise_tiled(noisy, guidance, baked_crop, params.settings, stats_);
 
   correction_ = ImageF(size, size, 3, 0.0f);
   for (int c = 0; c < 3; ++c)
@@ -170,7 +235,7 @@ AlbedoCorrection::AlbedoCorrection(const std::vector<Eigen::Vector3f>& vertices,
       for (int x = box.x0; x < box.x1; ++x)
         if (baked[std::size_t(y) * size + x])
           correction_.at(x, y, c) =
-              run.result.at(x - box.x0, y - box.y0, c) - noisy.at(x - box.x0, y - box.y0, c);
+              denoised.at(x - box.x0, y - box.y0, c) - noisy.at(x - box.x0, y - box.y0, c);
 }
 
 Eigen::Vector3f AlbedoCorrection::operator()(const Eigen::Vector3f& p, int t) const {

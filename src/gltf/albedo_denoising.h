@@ -3,9 +3,9 @@
 // docs/reflectance.md "Export"). A voxel's refined kd is a mean over its observations (paper 1,
 // eq. (7)), so it is noisy where the voxel was seen few times. The mesh is laid out again at the
 // observation grid's density (one texel per voxel: the resolution the kd has), baked, and
-// denoised by guided DIP with a guidance map from the local noise level and the observation
-// count. The correction (denoised - baked) is what the full atlas receives, so texels the
-// guidance keeps keep their full-resolution detail.
+// denoised by guided DIP, in overlapping tiles of at most 256^2, with a guidance map from the
+// local noise level and the observation count. The correction (denoised - baked) is what the full
+// atlas receives, so texels the guidance keeps keep their full-resolution detail.
 #include <Eigen/Core>
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -27,10 +27,11 @@ struct AlbedoDenoiseParams {
 struct AlbedoDenoiseStats {
   int width = 0, height = 0;  // the denoised image (the low-resolution atlas, cropped)
   float texels_per_metre = 0;
-  std::size_t texels = 0;      // baked texels
-  double guided_fraction = 0;  // baked texels whose guidance is below 1
-  double seconds = 0;          // the denoiser's
-  int iterations = 0;
+  std::size_t texels = 0;             // baked texels
+  double guided_fraction = 0;         // baked texels whose guidance is below 1
+  int tiles = 0, tiles_denoised = 0;  // tiles of at most 256^2; those with a guided texel
+  double seconds = 0;                 // the denoiser's, summed over the tiles
+  int iterations = 0;                 // per tile
   std::string device;
   nlohmann::json to_json() const;
 };
