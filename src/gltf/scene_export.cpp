@@ -159,7 +159,6 @@ void denoise_and_evaluate(const Reconstruction& scene,
   const SurfaceSampler observations = [&](const Eigen::Vector3f& p, int) {
     return Eigen::Vector3f(sampler.observations(p), 0, 0);
   };
-  const ImageF counts = bake_atlas(layout, scene.vertices, observations, atlas);
   const ImageF baked_kd = image;
   if (params.denoise_albedo) {
     const AlbedoCorrection correction(
@@ -177,6 +176,8 @@ void denoise_and_evaluate(const Reconstruction& scene,
   const AlbedoTruth truth(params.albedo_truth);
   const ImageF true_kd = bake_atlas(
       layout, scene.vertices, [&](const Eigen::Vector3f& p, int) { return truth(p); }, atlas);
+  // The split by observation count is needed only here: the denoiser bakes its own counts.
+  const ImageF counts = bake_atlas(layout, scene.vertices, observations, atlas);
   nlohmann::json& report = stats.albedo["truth"];
   report["sequence"] = params.albedo_truth;
   report["views"] = truth.views();
