@@ -9,7 +9,6 @@
 #include "commands.h"
 #include "core/error.h"
 #include "core/log.h"
-#include "core/progress.h"
 #include "core/timer.h"
 #include "edges/features.h"
 #include "edges/train_plugin.h"
@@ -39,7 +38,6 @@ edges::Model train_in_plugin(const edges::TrainingSet& set, const edges::ModelCo
   call.data = &set;
   call.config = &config;
   call.params = &params;
-  call.quiet = is_quiet();
   call.result = &model;
   if (entry(&call) != 0) call.failure.rethrow();
   return model;

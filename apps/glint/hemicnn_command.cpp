@@ -51,7 +51,6 @@ reflectance::HemiCnn train_in_plugin(const reflectance::HemiDataset& data,
   call.data = &data;
   call.config = &config;
   call.params = &params;
-  call.quiet = is_quiet();
   call.result = &model;
   if (entry(&call) != 0) call.failure.rethrow();
   return model;

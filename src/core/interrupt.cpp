@@ -9,6 +9,8 @@ namespace {
 // Lock-free, so it may be written from a signal handler.
 std::atomic<int> arrived_signal{0};
 static_assert(std::atomic<int>::is_always_lock_free);
+// The flag interrupt_signal() reads: this copy's own, or the host's in a loadable module.
+std::atomic<const std::atomic<int>*> polled_flag{&arrived_signal};
 
 extern "C" void on_interrupt_signal(int signal_number) {
   arrived_signal.store(signal_number, std::memory_order_relaxed);
@@ -33,7 +35,17 @@ void install_interrupt_handlers() {
   }
 }
 
-int interrupt_signal() noexcept { return arrived_signal.load(std::memory_order_relaxed); }
+int interrupt_signal() noexcept {
+  return polled_flag.load(std::memory_order_relaxed)->load(std::memory_order_relaxed);
+}
+
+const std::atomic<int>* interrupt_flag() noexcept {
+  return polled_flag.load(std::memory_order_relaxed);
+}
+
+void follow_interrupt_flag(const std::atomic<int>* flag) noexcept {
+  polled_flag.store(flag != nullptr ? flag : &arrived_signal, std::memory_order_relaxed);
+}
 
 void throw_if_interrupted() {
   const int signal_number = interrupt_signal();

@@ -9,6 +9,7 @@
 // turns it into exit status 128 + signal (130 for SIGINT, 143 for SIGTERM). A second signal ends
 // the process at once (the default action). Without install_interrupt_handlers() (the library in
 // another program, Python) the flag is never set and nothing changes.
+#include <atomic>
 #include <exception>
 
 namespace glint {
@@ -33,6 +34,11 @@ void install_interrupt_handlers();
 
 // The signal that arrived, 0 when none did.
 int interrupt_signal() noexcept;
+
+// The flag the signal handler sets. A loadable module has its own copy of this file; it polls the
+// host's flag after follow_interrupt_flag(host's interrupt_flag()) (core/plugin_call.h).
+const std::atomic<int>* interrupt_flag() noexcept;
+void follow_interrupt_flag(const std::atomic<int>* flag) noexcept;
 
 // Throws Interrupted when a signal arrived. Cheap (one relaxed atomic load).
 void throw_if_interrupted();

@@ -14,7 +14,7 @@ struct DenoisePluginCall {
   const ImageF* noisy = nullptr;
   const ImageF* guidance = nullptr;  // may be null for unguided methods
   const NeuralParams* params = nullptr;
-  bool quiet = false;  // the module has its own copy of the progress-bar switch
+  PluginHostState host;  // the module follows the host's --quiet and interrupt flag
   ImageF* result = nullptr;
   NeuralStats* stats = nullptr;
   PluginFailure failure;  // set when the call returns 1

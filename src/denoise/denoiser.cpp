@@ -6,7 +6,6 @@
 #include <chrono>
 
 #include "core/error.h"
-#include "core/progress.h"
 #include "core/resources.h"
 #include "denoise/denoise_plugin.h"
 
@@ -84,7 +83,6 @@ DenoiseRun run_denoiser(const std::string& method, const DenoiserSettings& setti
   call.noisy = &noisy;
   call.guidance = guidance;
   call.params = &params;
-  call.quiet = is_quiet();
   call.result = &run.result;
   call.stats = &run.stats;
   if (entry(&call) != 0) call.failure.rethrow();

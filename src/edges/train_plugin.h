@@ -15,7 +15,7 @@ struct TrainPluginCall {
   const TrainingSet* data = nullptr;
   const ModelConfig* config = nullptr;
   const TrainParams* params = nullptr;
-  bool quiet = false;  // the module has its own copy of the progress-bar switch
+  PluginHostState host;  // the module follows the host's --quiet and interrupt flag
   Model* result = nullptr;
   PluginFailure failure;  // set when the call returns 1
 };

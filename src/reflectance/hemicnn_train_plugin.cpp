@@ -2,11 +2,9 @@
 #include "reflectance/hemicnn_train_plugin.h"
 
 #include "core/plugin_call.h"
-#include "core/progress.h"
 
 extern "C" int glint_hemicnn_plugin_entry(glint::reflectance::HemiCnnPluginCall* call) {
-  return glint::run_in_plugin(call->failure, "HemiCNN training", [call] {
-    glint::set_quiet(call->quiet);
+  return glint::run_in_plugin(call->host, call->failure, "HemiCNN training", [call] {
     *call->result = glint::reflectance::train_hemicnn(*call->data, *call->config, *call->params);
   });
 }

@@ -13,7 +13,7 @@ struct HemiCnnPluginCall {
   const HemiDataset* data = nullptr;
   const HemiCnnConfig* config = nullptr;
   const HemiCnnTrainParams* params = nullptr;
-  bool quiet = false;  // the module has its own copy of the progress-bar switch
+  PluginHostState host;  // the module follows the host's --quiet and interrupt flag
   HemiCnn* result = nullptr;
   PluginFailure failure;  // set when the call returns 1
 };

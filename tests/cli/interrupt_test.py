@@ -3,7 +3,8 @@
 143 (SIGTERM) with one line, and leaves neither its output nor any partial or temporary file.
 
 Usage: interrupt_test.py GLINT_BINARY [CASE ...]   (cases: render, render-sigterm, reconstruct,
-classify, classify-tiled (LAS in tiles, its temporary tile folder); default all). Not timing-dependent: each signal is sent once the command's staging
+classify, classify-tiled (LAS in tiles, its temporary tile folder), denoise (SIGTERM inside the
+libtorch module's loop); default all). Not timing-dependent: each signal is sent once the command's staging
 folder (or, for classify, its first log line) exists, and each run is made long enough to be
 still working then; a command that ends before the signal fails the test instead of passing.
 """
@@ -16,9 +17,11 @@ import subprocess
 import sys
 import tempfile
 import time
+import zlib
 
 GLINT = sys.argv[1]
-CASES = sys.argv[2:] or ["render", "render-sigterm", "reconstruct", "classify", "classify-tiled"]
+CASES = sys.argv[2:] or ["render", "render-sigterm", "reconstruct", "classify", "classify-tiled",
+                         "denoise"]
 WORK = tempfile.mkdtemp(prefix="glint_interrupt_test_")
 failures = []
 
@@ -47,10 +50,13 @@ def leftovers(output):
     return sorted(entry for entry in os.listdir(folder) if entry.startswith(name))
 
 
-def interrupt(case, arguments, output, ready, what, sent=signal.SIGINT, stderr_ready=None):
+def interrupt(case, arguments, output, ready, what, sent=signal.SIGINT, stderr_ready=None,
+              on_start=None):
     """Runs glint ARGUMENTS, sends `sent` once `ready` holds, checks the status and that no
     file whose name starts with `output` is left."""
     process = subprocess.Popen([GLINT] + arguments, stderr=subprocess.PIPE, text=True)
+    if on_start is not None:
+        on_start(process)
     try:
         if stderr_ready is None:
             wait_until(process, ready, what)
@@ -128,6 +134,22 @@ def write_las(path, points, seed):
         file.write(header + records)
 
 
+def write_noise_png(path, side, seed):
+    """An 8-bit grey PNG of uniform noise, side x side."""
+    generator = random.Random(seed)
+    rows = b"".join(b"\0" + bytes(generator.randrange(256) for _ in range(side))
+                    for _ in range(side))
+
+    def chunk(kind, data):
+        return (struct.pack(">I", len(data)) + kind + data +
+                struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+
+    with open(path, "wb") as file:
+        file.write(b"\x89PNG\r\n\x1a\n" +
+                   chunk(b"IHDR", struct.pack(">IIBBBBB", side, side, 8, 0, 0, 0, 0)) +
+                   chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
+
+
 try:
     scene = os.path.join(WORK, "scene")
     if {"render", "render-sigterm", "reconstruct"} & set(CASES):
@@ -160,6 +182,23 @@ try:
                   output, lambda: any(entry.startswith("survey_edges.las.tiles-")
                                       for entry in os.listdir(WORK)),
                   "the temporary tile folder")
+    if "denoise" in CASES:
+        # The signal arrives inside the libtorch module, which has its own copy of glint_core
+        # and must poll the host's flag; sent once the module is mapped into the process. With
+        # no snapshots nothing on the host side polls until the million steps are done.
+        noisy = os.path.join(WORK, "noisy.png")
+        write_noise_png(noisy, 64, seed=3)
+        output = os.path.join(WORK, "denoised.png")
+        process_maps = []
+
+        def module_loaded():
+            with open(process_maps[0]) as maps:
+                return "denoise-nets.so" in maps.read()
+
+        interrupt("denoise", ["denoise", "run", noisy, "-o", output, "--method", "dip",
+                              "--iterations", "1000000"],
+                  output, module_loaded, "the denoiser module", signal.SIGTERM,
+                  on_start=lambda process: process_maps.append(f"/proc/{process.pid}/maps"))
 finally:
     shutil.rmtree(WORK, ignore_errors=True)
 

@@ -8,6 +8,7 @@
 #include <csignal>
 
 #include "core/parallel.h"
+#include "core/plugin_call.h"
 #include "core/progress.h"
 
 namespace glint {
@@ -47,6 +48,33 @@ TEST_F(InterruptTest, SigtermGivesStatus143) {
   set_interrupt_signal_for_testing(SIGTERM);
   try {
     throw_if_interrupted();
+    FAIL() << "no Interrupted";
+  } catch (const Interrupted& e) {
+    EXPECT_EQ(e.exit_status(), 143);
+  }
+}
+
+// A loadable module polls the flag its host hands it (its own copy of the flag is never set) and
+// returns the signal, which the host throws again as Interrupted rather than as an error.
+TEST_F(InterruptTest, APluginFollowsTheHostFlagAndHandsTheSignalBack) {
+  std::atomic<int> host_flag{0};
+  PluginHostState host;
+  host.interrupt_flag = &host_flag;
+  PluginFailure failure;
+  int steps = 0;
+  const int status = run_in_plugin(host, failure, "test loop", [&] {
+    ProgressBar progress("test", 100);
+    for (; steps < 100; ++steps) {
+      if (steps == 10) host_flag.store(SIGTERM);
+      progress.advance();
+    }
+  });
+  follow_interrupt_flag(nullptr);  // back to this copy's own flag
+  EXPECT_EQ(status, 1);
+  EXPECT_EQ(steps, 10);
+  EXPECT_EQ(interrupt_signal(), 0);
+  try {
+    failure.rethrow();
     FAIL() << "no Interrupted";
   } catch (const Interrupted& e) {
     EXPECT_EQ(e.exit_status(), 143);
