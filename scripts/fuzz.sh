@@ -5,6 +5,8 @@
 #   New inputs go to BUILD_DIR/corpus/<target> (the seed corpus fuzz/corpus/<target> is only
 #   read), crash, timeout and out-of-memory inputs to BUILD_DIR/crashes/<target>-*, the full
 #   logs to BUILD_DIR/logs/<target>.log. Exits 1 when any target found something.
+#   FUZZ_RUNS=N also stops a target after N executions (issue-style budgets: "10^6 executions
+#   or an hour, whichever first" is FUZZ_RUNS=1000000 with SECONDS=3600).
 #   The targets write each input to a scratch file ($TMPDIR); FUZZ_TMPDIR (default /dev/shm when
 #   writable, else BUILD_DIR/tmp) keeps those writes off the disk.
 set -euo pipefail
@@ -30,7 +32,7 @@ for name in "${targets[@]}"; do
   # finding rather than a swapping machine.
   status=0
   TMPDIR="$scratch" nice -n 10 "$build/fuzz/fuzz_$name" -max_total_time="$seconds" \
-    -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+    -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 -runs="${FUZZ_RUNS:--1}" \
     -artifact_prefix="$build/crashes/$name-" "$work" "$source_dir/fuzz/corpus/$name" \
     >"$log" 2>&1 || status=$?
   executions=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
