@@ -4,9 +4,10 @@
 
 Usage: interrupt_test.py GLINT_BINARY [CASE ...]   (cases: render, render-sigterm, reconstruct,
 classify, classify-tiled (LAS in tiles, its temporary tile folder), denoise (SIGTERM inside the
-libtorch module's loop); default all). Not timing-dependent: each signal is sent once the command's staging
-folder (or, for classify, its first log line) exists, and each run is made long enough to be
-still working then; a command that ends before the signal fails the test instead of passing.
+libtorch module's loop); default all). Not timing-dependent: each signal is sent once the
+command's staging folder (classify: its first log line; denoise: the module mapped) exists, and
+each run is made long enough to be still working then; a command that ends before the signal
+fails the test instead of passing.
 """
 import os
 import random
