@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <system_error>
@@ -39,7 +41,7 @@ std::string write_scratch_file(const std::string& name, std::string_view data) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(data.data(), static_cast<std::streamsize>(data.size()));
   out.close();
-  if (!out) throw std::runtime_error("fuzz: cannot write " + path);
+  if (!out) throw std::runtime_error("fuzz: cannot write " + path + ": " + std::strerror(errno));
   return path;
 }
 

@@ -215,12 +215,13 @@ void run_eval(const EvalOptions& options) {
              options.protocol_seed, options.denoiser.config);
   fmt::print("{:<18} {:>9} {:>9} {:>9} {:>8} {:>8} {:>9}\n", "method (mean)", "PSNR", "clean",
              "noisy", "SSIM", "AUC", "seconds");
-  for (const auto& [method, metrics] : summary.items()) {
+  for (const auto& item : summary.items()) {
+    const nlohmann::json& metrics = item.value();
     const auto mean = [&](const char* key) {
       return metrics.contains(key) ? fmt::format("{:.3f}", metrics[key]["mean"].get<double>())
                                    : std::string("-");
     };
-    fmt::print("{:<18} {:>9} {:>9} {:>9} {:>8} {:>8} {:>9}\n", method, mean("psnr"),
+    fmt::print("{:<18} {:>9} {:>9} {:>9} {:>8} {:>8} {:>9}\n", item.key(), mean("psnr"),
                mean("psnr_clean"), mean("psnr_noisy"), mean("ssim"), mean("auc"), mean("seconds"));
   }
   if (!options.report.empty())

@@ -95,7 +95,9 @@ void write_material_plots(const std::string& path,
     io::PlotPanel& panel = figure.panels.emplace_back();
     panel.title = row.title;
     panel.y_label = row.label;
-    for (const auto& [object, samples] : evaluation.series()) {
+    for (const auto& [object, object_samples] : evaluation.series()) {
+      // clang 14 (the fuzz and sanitizer builds) cannot capture a structured binding in a lambda.
+      const auto& samples = object_samples;
       const Eigen::Vector3f colour = segment_colour(object) * 0.85f;
       const std::array<std::uint8_t, 3> rgb{std::uint8_t(colour.x() * 255),
                                             std::uint8_t(colour.y() * 255),

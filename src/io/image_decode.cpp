@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
 #include <sstream>
+#include <vector>
 
 #include "core/error.h"
 #include "core/limits.h"
@@ -57,29 +58,51 @@ std::optional<Size> jpeg_size(std::string_view bytes) {
   return std::nullopt;
 }
 
-// OpenEXR: the header's attributes are "name\0type\0" + int32 size + value; the data window
-// (box2i: xMin, yMin, xMax, yMax) gives the size.
-std::optional<Size> exr_size(std::string_view bytes) {
-  std::size_t at = 8;  // magic number, version
-  while (at < bytes.size() && bytes[at] != '\0') {
-    const std::size_t name_end = bytes.find('\0', at);
-    if (name_end == std::string_view::npos) return std::nullopt;
-    const std::size_t type_end = bytes.find('\0', name_end + 1);
-    if (type_end == std::string_view::npos || type_end + 5 > bytes.size()) return std::nullopt;
-    const std::string_view name = bytes.substr(at, name_end - at);
-    const std::int32_t size = little_endian_32(bytes, type_end + 1);
-    const std::size_t value = type_end + 5;
-    if (size < 0 || value + std::size_t(size) > bytes.size()) return std::nullopt;
-    if (name == "dataWindow" && size == 16) {
-      const std::int64_t x_min = little_endian_32(bytes, value),
-                         y_min = little_endian_32(bytes, value + 4);
-      const std::int64_t x_max = little_endian_32(bytes, value + 8),
-                         y_max = little_endian_32(bytes, value + 12);
-      return Size{x_max - x_min + 1, y_max - y_min + 1};
+constexpr std::string_view kExrMagic("\x76\x2f\x31\x01", 4);
+constexpr std::uint32_t kExrMultiPartFlag = 0x1000;  // in the version field
+
+// OpenEXR: magic number, version, then a header of attributes "name\0type\0" + int32 size +
+// value ended by a null byte (several headers ended by an empty one in a multi-part file).
+// OpenEXR allocates and clears each attribute's declared size before reading it, so a garbled
+// size costs gigabytes and seconds: every size must fit in the file. Returns each part's
+// dataWindow size (box2i: xMin, yMin, xMax, yMax).
+std::vector<Size> exr_part_sizes(const std::string& path, std::string_view bytes) {
+  const auto fail = [&](const std::string& reason) {
+    throw Error(path, "header", "not a readable OpenEXR file: " + reason);
+  };
+  if (bytes.size() < 8) fail("it ends inside its version field");
+  const bool multi_part = (std::uint32_t(little_endian_32(bytes, 4)) & kExrMultiPartFlag) != 0;
+  std::vector<Size> sizes;
+  std::size_t at = 8;
+  do {
+    std::optional<Size> window;
+    while (at < bytes.size() && bytes[at] != '\0') {
+      const std::size_t name_end = bytes.find('\0', at);
+      const std::size_t type_end =
+          name_end == std::string_view::npos ? name_end : bytes.find('\0', name_end + 1);
+      if (type_end == std::string_view::npos || type_end + 5 > bytes.size())
+        fail("the header runs past the end of the file");
+      const std::string_view name = bytes.substr(at, name_end - at);
+      const std::int32_t size = little_endian_32(bytes, type_end + 1);
+      const std::size_t value = type_end + 5;
+      if (size < 0 || std::size_t(size) > bytes.size() - value)
+        fail(fmt::format("the attribute at byte {} declares {} bytes, {} are left in the file", at,
+                         size, bytes.size() - value));
+      if (name == "dataWindow" && size == 16) {
+        const std::int64_t x_min = little_endian_32(bytes, value),
+                           y_min = little_endian_32(bytes, value + 4);
+        const std::int64_t x_max = little_endian_32(bytes, value + 8),
+                           y_max = little_endian_32(bytes, value + 12);
+        window = Size{x_max - x_min + 1, y_max - y_min + 1};
+      }
+      at = value + std::size_t(size);
     }
-    at = value + std::size_t(size);
-  }
-  return std::nullopt;
+    if (at >= bytes.size()) fail("the header runs past the end of the file");
+    if (!window) fail("a header has no dataWindow");
+    sizes.push_back(*window);
+    ++at;  // the header's closing null byte
+  } while (multi_part && at < bytes.size() && bytes[at] != '\0');
+  return sizes;
 }
 
 // Radiance HDR: header lines, a blank line, then "-Y height +X width" (or another orientation).
@@ -97,16 +120,22 @@ std::optional<Size> hdr_size(std::string_view bytes) {
   return first_axis == 'Y' ? Size{second, first} : Size{first, second};
 }
 
+// OpenCV hands a file whose first four bytes are "NITF", or with "DTED" at byte 140, to GDAL,
+// which tries every one of its raster drivers on it and prints their complaints on stderr: GIS
+// rasters are refused here instead (OpenCV's GdalDecoder::checkSignature).
+bool is_gdal_raster(std::string_view bytes) {
+  return bytes.starts_with("NITF") || (bytes.size() > 144 && bytes.substr(140, 4) == "DTED");
+}
+
 bool is_hdr(std::string_view bytes) {
   return bytes.starts_with("#?RADIANCE") || bytes.starts_with("#?RGBE");
 }
 
-// The image's size from its header, for the formats that say it there.
+// The image's size from its header, for the formats other than OpenEXR that say it there.
 std::optional<Size> header_size(std::string_view bytes) {
   if (bytes.starts_with(kPngSignature) && bytes.size() >= 24 && bytes.substr(12, 4) == "IHDR")
     return Size{big_endian_32(bytes, 16), big_endian_32(bytes, 20)};
   if (bytes.starts_with("\xff\xd8\xff")) return jpeg_size(bytes);
-  if (bytes.starts_with("\x76\x2f\x31\x01")) return exr_size(bytes);
   if (is_hdr(bytes)) return hdr_size(bytes);
   return std::nullopt;
 }
@@ -284,6 +313,11 @@ void require_complete_image(const std::string& path, std::string_view bytes) {
 }
 
 void require_image_size_allowed(const std::string& path, std::string_view bytes) {
+  if (bytes.starts_with(kExrMagic)) {
+    for (const Size& size : exr_part_sizes(path, bytes))
+      limits::check_image_size(size.width, size.height, path, "header");
+    return;
+  }
   if (const std::optional<Size> size = header_size(bytes))
     limits::check_image_size(size->width, size->height, path, "header");
 }
@@ -300,6 +334,10 @@ cv::Mat decode_image_file(const std::string& path, int flags) {
   require_image_size_allowed(path, bytes);
   require_complete_image(path, bytes);
   if (std::string_view(bytes).starts_with(kPngSignature)) return decode_png(path, bytes, flags);
+  if (is_gdal_raster(bytes))
+    throw Error(
+        path, "",
+        "a NITF or DTED raster, which glint does not read (convert it to TIFF, PNG or EXR)");
   cv::Mat image;
   OpenCvMessages messages;
   try {

@@ -15,7 +15,9 @@ namespace glint::io {
 void require_complete_image(const std::string& path, std::string_view bytes);
 
 // Throws glint::Error(path, "header", ...) when the image's header (PNG, JPEG, OpenEXR, Radiance
-// HDR) declares a size beyond core/limits.h's pixel budget; other formats are not checked here.
+// HDR) declares a size beyond core/limits.h's pixel budget, or when an OpenEXR header is cut
+// short, lacks its dataWindow or declares an attribute larger than the rest of the file (which
+// OpenEXR would allocate); other formats are not checked here.
 void require_image_size_allowed(const std::string& path, std::string_view bytes);
 
 // Reads and decodes the image file with cv::imdecode `flags`; throws glint::Error naming it

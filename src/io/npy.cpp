@@ -1,5 +1,8 @@
 #include "io/npy.h"
 
+#include <fmt/format.h>
+
+#include <charconv>
 #include <cstdint>
 #include <cstring>
 #include <regex>
@@ -48,31 +51,44 @@ NpyArray read_npy(const std::string& path) {
   std::size_t header_length = 0;
   for (std::size_t i = 0; i < length_size; ++i)
     header_length |= std::size_t(static_cast<unsigned char>(bytes[8 + i])) << (8 * i);
+  // NumPy's own reader refuses longer headers (numpy.lib.format, max_header_size); the bound
+  // also keeps std::regex's recursive matching below off deep stacks.
+  constexpr std::size_t kMaxHeaderLength = 10000;
+  if (header_length > kMaxHeaderLength)
+    throw Error(path, "header",
+                fmt::format("the header is {} bytes long, more than NumPy's limit of {}",
+                            header_length, kMaxHeaderLength));
   const std::size_t data_start = 8 + length_size + header_length;
   if (data_start > bytes.size()) throw Error(path, "header", "truncated header");
   const std::string header = bytes.substr(8 + length_size, header_length);
 
+  // Compiled once: compiling them costs more than reading a small array.
+  static const std::regex descr_field("'descr':\\s*'([<>|=]?[a-z]\\d+)'");
+  static const std::regex fortran_field("'fortran_order':\\s*True");
+  static const std::regex shape_field("'shape':\\s*\\(([^)]*)\\)");
+  static const std::regex extent_digits("\\d+");
+
   std::smatch match;
-  if (!std::regex_search(header, match, std::regex("'descr':\\s*'([<>|=]?[a-z]\\d+)'")))
+  if (!std::regex_search(header, match, descr_field))
     throw Error(path, "header", "no dtype ('descr')");
   const std::string descr = match[1];
   const bool is_f4 = descr == "<f4" || descr == "f4";
   const bool is_f8 = descr == "<f8" || descr == "f8";
   if (!is_f4 && !is_f8)
     throw Error(path, "header", "dtype " + descr + " is not supported (float32 or float64)");
-  if (std::regex_search(header, std::regex("'fortran_order':\\s*True")))
+  if (std::regex_search(header, fortran_field))
     throw Error(path, "header", "Fortran-order arrays are not supported (save with C order)");
-  if (!std::regex_search(header, match, std::regex("'shape':\\s*\\(([^)]*)\\)")))
-    throw Error(path, "header", "no shape");
+  if (!std::regex_search(header, match, shape_field)) throw Error(path, "header", "no shape");
 
   NpyArray array;
   std::size_t count = 1;
   const std::string dims = match[1];
-  const std::regex number("\\d+");
-  for (auto it = std::sregex_iterator(dims.begin(), dims.end(), number);
+  for (auto it = std::sregex_iterator(dims.begin(), dims.end(), extent_digits);
        it != std::sregex_iterator(); ++it) {
-    const std::size_t extent = std::stoull(it->str());
-    if (extent != 0 && count > (std::size_t(1) << 40) / extent)
+    const std::string digits = it->str();
+    std::size_t extent = 0;
+    const auto parsed = std::from_chars(digits.data(), digits.data() + digits.size(), extent);
+    if (parsed.ec != std::errc() || (extent != 0 && count > (std::size_t(1) << 40) / extent))
       throw Error(path, "header", "shape is implausibly large");
     array.shape.push_back(extent);
     count *= extent;

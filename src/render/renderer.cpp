@@ -156,14 +156,14 @@ struct Renderer::Impl {
   }
 
   // Direct lighting at a hit seen along -wo (paper 1, eq. 1 with eqs 2-4): the point lights
-  // (visibility of light l at light_visible[l * stride], from the row's shadow rays) and the
+  // (visibility of light l at light_visible[l * stride + x], from the row's shadow rays) and the
   // importance-sampled environment.
   Eigen::Vector3f shade(const Hit& hit, const WardMaterial& material, const Eigen::Vector3f& wo,
-                        const std::uint8_t* light_visible, std::size_t stride, std::uint64_t pixel,
-                        int frame_index) const {
+                        const std::vector<std::uint8_t>& light_visible, std::size_t x,
+                        std::size_t stride, std::uint64_t pixel, int frame_index) const {
     Eigen::Vector3f radiance = Eigen::Vector3f::Zero();
     for (std::size_t l = 0; l < scene.lights.size(); ++l)
-      if (light_visible[l * stride])
+      if (light_visible[l * stride + x])
         radiance += point_light(hit, material, wo, light_path(hit, scene.lights[l]), l);
     if (!environment) return radiance;
     const int samples = std::max(1, scene.environment->samples);
@@ -347,8 +347,8 @@ FrameBuffers Renderer::render(const Pose& camera_to_world, int frame_index) cons
           if (row.shaded[x]) {
             WardMaterial material = surface.material;
             material.kd = hit.kd;
-            radiance = impl.shade(hit, material, -unit_direction, row.light_visible.data() + x,
-                                  width, pixel, frame_index);
+            radiance = impl.shade(hit, material, -unit_direction, row.light_visible, x, width,
+                                  pixel, frame_index);
             if (impl.scene.bounces > 0)
               radiance += impl.indirect(hit, material, -unit_direction, pixel, frame_index);
             out.segment.plane(0)[pixel] = surface.segment_id;

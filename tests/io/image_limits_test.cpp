@@ -1,7 +1,8 @@
 // Image decoding: the size in a file's header is checked against the pixel budget before any
-// pixel is decoded; libpng's messages become part of glint's one error line (nothing of their
-// own on stderr), with the samples cv::imdecode gives; a failed Radiance HDR read leaves no
-// temporary copy of the input behind.
+// pixel is decoded, and an OpenEXR header's attribute sizes against the file; libpng's messages
+// become part of glint's one error line (nothing of their own on stderr), with the samples
+// cv::imdecode gives; GIS rasters are refused before OpenCV hands them to GDAL; a failed Radiance
+// HDR read leaves no temporary copy of the input behind.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -47,6 +48,40 @@ TEST(ImageLimits, HeaderBeyondThePixelBudgetIsRefusedBeforeDecoding) {
   write_text(jpeg, std::string("\xff\xd8\xff\xc0\x00\x11\x08\x4e\x20\x9c\x40\x03", 12) +
                        std::string(9, '\x01') + std::string("\xff\xda\x00\x02\xff\xd9", 6));
   EXPECT_THAT(error_of([&] { read_image(jpeg); }).reason(), HasSubstr("40000x20000 pixels"));
+}
+
+// OpenEXR allocates an attribute's declared size before reading it: a garbled size is refused
+// on the header walk, before OpenEXR sees the file.
+TEST(ImageLimits, ExrAttributeLargerThanTheFileIsRefusedBeforeDecoding) {
+  const std::string path = scratch("garbled.exr");
+  write_image(path, ImageF(8, 4, 3, 0.5f));
+  std::string bytes = read_text(path);
+  ASSERT_EQ(read_image(path).width(), 8);
+  const std::size_t size_field = bytes.find("chlist") + 7;  // the channels attribute's size
+  const std::string intact = bytes;
+  bytes.replace(size_field, 4, "\xff\xff\xff\x7f");
+  write_text(path, bytes);
+  const Error error = error_of([&] { read_image(path); });
+  EXPECT_EQ(error.file(), path);
+  EXPECT_EQ(error.element(), "header");
+  EXPECT_THAT(error.reason(), ::testing::MatchesRegex("not a readable OpenEXR file: the "
+                                                      "attribute at byte 8 declares 2147483647 "
+                                                      "bytes, [0-9]+ are left in the file"));
+  write_text(path, intact.substr(0, 20));  // cut inside the first attribute's name and type
+  EXPECT_EQ(error_of([&] { read_image(path); }).reason(),
+            "not a readable OpenEXR file: the header runs past the end of the file");
+}
+
+// OpenCV would pass these to GDAL, which tries all of its drivers and prints on stderr.
+TEST(ImageLimits, GisRastersAreRefusedWithOneLine) {
+  const std::string path = scratch("map.ntf");
+  write_text(path, "NITF02.10" + std::string(400, '0'));
+  ::testing::internal::CaptureStderr();
+  const Error error = error_of([&] { read_image(path); });
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+  EXPECT_EQ(error.file(), path);
+  EXPECT_EQ(error.reason(),
+            "a NITF or DTED raster, which glint does not read (convert it to TIFF, PNG or EXR)");
 }
 
 TEST(ImageLimits, CorruptPngIsOneErrorWithLibpngsReasonAndNothingOnStderr) {

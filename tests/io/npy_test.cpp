@@ -82,6 +82,16 @@ TEST(Npy, MalformedFilesNameTheProblem) {
                                doubles({1})));
   EXPECT_THAT(error_of([&] { read_npy(fortran); }).reason(), HasSubstr("Fortran"));
 
+  // An extent beyond 64 bits, and a header longer than NumPy itself accepts.
+  const std::string huge = scratch("huge.npy");
+  write_text(huge, npy_file(1, "{'descr': '<f4', 'shape': (99999999999999999999999,), }\n", ""));
+  EXPECT_EQ(error_of([&] { read_npy(huge); }).reason(), "shape is implausibly large");
+  const std::string padded = scratch("padded.npy");
+  write_text(padded, npy_file(2, "{'descr': '<f4', 'shape': (1,), }" + std::string(20000, ' '),
+                              std::string(4, '\0')));
+  EXPECT_EQ(error_of([&] { read_npy(padded); }).reason(),
+            "the header is 20033 bytes long, more than NumPy's limit of 10000");
+
   const std::string text = scratch("text.npy");
   write_text(text, "hello");
   EXPECT_EQ(error_of([&] { read_npy(text); }).file(), text);
