@@ -120,11 +120,15 @@ std::optional<Size> hdr_size(std::string_view bytes) {
   return first_axis == 'Y' ? Size{second, first} : Size{first, second};
 }
 
-// OpenCV hands a file whose first four bytes are "NITF", or with "DTED" at byte 140, to GDAL,
-// which tries every one of its raster drivers on it and prints their complaints on stderr: GIS
-// rasters are refused here instead (OpenCV's GdalDecoder::checkSignature).
-bool is_gdal_raster(std::string_view bytes) {
-  return bytes.starts_with("NITF") || (bytes.size() > 144 && bytes.substr(140, 4) == "DTED");
+// The formats OpenCV hands to GDAL ("NITF" at byte 0, "DTED" at byte 140) or to GDCM ("DICM" at
+// byte 128; OpenCV's GdalDecoder / DICOMDecoder::checkSignature): GDAL tries every raster driver
+// it has and prints their complaints on stderr, GDCM aborts the process on some malformed files
+// (an assertion). glint reads photographs, depth and environment maps, never these.
+std::optional<std::string_view> gis_or_medical_format(std::string_view bytes) {
+  if (bytes.starts_with("NITF")) return "a NITF raster";
+  if (bytes.size() > 144 && bytes.substr(140, 4) == "DTED") return "a DTED raster";
+  if (bytes.size() >= 132 && bytes.substr(128, 4) == "DICM") return "a DICOM file";
+  return std::nullopt;
 }
 
 bool is_hdr(std::string_view bytes) {
@@ -334,10 +338,10 @@ cv::Mat decode_image_file(const std::string& path, int flags) {
   require_image_size_allowed(path, bytes);
   require_complete_image(path, bytes);
   if (std::string_view(bytes).starts_with(kPngSignature)) return decode_png(path, bytes, flags);
-  if (is_gdal_raster(bytes))
+  if (const auto format = gis_or_medical_format(bytes))
     throw Error(
         path, "",
-        "a NITF or DTED raster, which glint does not read (convert it to TIFF, PNG or EXR)");
+        fmt::format("{}, which glint does not read (convert it to PNG, TIFF or EXR)", *format));
   cv::Mat image;
   OpenCvMessages messages;
   try {

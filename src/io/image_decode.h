@@ -22,7 +22,8 @@ void require_image_size_allowed(const std::string& path, std::string_view bytes)
 
 // Reads and decodes the image file with cv::imdecode `flags`; throws glint::Error naming it
 // when it is missing, empty, truncated, larger than the pixel budget (checked on the header,
-// before decoding) or not decodable. PNG goes through libpng with glint's own message
+// before decoding), a GIS raster or DICOM file (which OpenCV would pass to GDAL or GDCM) or not
+// decodable. PNG goes through libpng with glint's own message
 // handlers (libpng's messages become part of the one error line, never a line of their own);
 // Radiance HDR is read from the file (no temporary copy).
 cv::Mat decode_image_file(const std::string& path, int flags);

@@ -1,8 +1,8 @@
 // Image decoding: the size in a file's header is checked against the pixel budget before any
 // pixel is decoded, and an OpenEXR header's attribute sizes against the file; libpng's messages
 // become part of glint's one error line (nothing of their own on stderr), with the samples
-// cv::imdecode gives; GIS rasters are refused before OpenCV hands them to GDAL; a failed Radiance
-// HDR read leaves no temporary copy of the input behind.
+// cv::imdecode gives; GIS and DICOM files are refused before OpenCV hands them to GDAL or GDCM;
+// a failed Radiance HDR read leaves no temporary copy of the input behind.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -72,16 +72,23 @@ TEST(ImageLimits, ExrAttributeLargerThanTheFileIsRefusedBeforeDecoding) {
             "not a readable OpenEXR file: the header runs past the end of the file");
 }
 
-// OpenCV would pass these to GDAL, which tries all of its drivers and prints on stderr.
-TEST(ImageLimits, GisRastersAreRefusedWithOneLine) {
-  const std::string path = scratch("map.ntf");
-  write_text(path, "NITF02.10" + std::string(400, '0'));
-  ::testing::internal::CaptureStderr();
-  const Error error = error_of([&] { read_image(path); });
-  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
-  EXPECT_EQ(error.file(), path);
-  EXPECT_EQ(error.reason(),
-            "a NITF or DTED raster, which glint does not read (convert it to TIFF, PNG or EXR)");
+// OpenCV would pass these to GDAL, which tries all of its drivers and prints on stderr, and to
+// GDCM, which aborts on some malformed DICOM files (an assertion; found by the image fuzz target,
+// fuzz/corpus/image/regression-dicom-gdcm-assertion).
+TEST(ImageLimits, GisAndMedicalFormatsAreRefusedWithOneLine) {
+  const std::string nitf = scratch("map.ntf");
+  write_text(nitf, "NITF02.10" + std::string(400, '0'));
+  const std::string dicom = scratch("scan.dcm");
+  write_text(dicom, std::string(128, '\x10') + "DICM" + std::string(64, '\x10'));
+  for (const auto& [file, format] : {std::pair{nitf, "a NITF raster"}, {dicom, "a DICOM file"}}) {
+    const std::string& path = file;  // clang 14 cannot capture a structured binding
+    ::testing::internal::CaptureStderr();
+    const Error error = error_of([&] { read_image(path); });
+    EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+    EXPECT_EQ(error.file(), path);
+    EXPECT_EQ(error.reason(),
+              std::string(format) + ", which glint does not read (convert it to PNG, TIFF or EXR)");
+  }
 }
 
 TEST(ImageLimits, CorruptPngIsOneErrorWithLibpngsReasonAndNothingOnStderr) {
