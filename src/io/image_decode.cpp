@@ -17,6 +17,7 @@
 #include "core/error.h"
 #include "core/limits.h"
 #include "io/file_bytes.h"
+#include "io/radiance_hdr.h"
 
 namespace glint::io {
 namespace {
@@ -131,16 +132,12 @@ std::optional<std::string_view> gis_or_medical_format(std::string_view bytes) {
   return std::nullopt;
 }
 
-bool is_hdr(std::string_view bytes) {
-  return bytes.starts_with("#?RADIANCE") || bytes.starts_with("#?RGBE");
-}
-
 // The image's size from its header, for the formats other than OpenEXR that say it there.
 std::optional<Size> header_size(std::string_view bytes) {
   if (bytes.starts_with(kPngSignature) && bytes.size() >= 24 && bytes.substr(12, 4) == "IHDR")
     return Size{big_endian_32(bytes, 16), big_endian_32(bytes, 20)};
   if (bytes.starts_with("\xff\xd8\xff")) return jpeg_size(bytes);
-  if (is_hdr(bytes)) return hdr_size(bytes);
+  if (is_radiance_hdr(bytes)) return hdr_size(bytes);
   return std::nullopt;
 }
 
@@ -342,18 +339,13 @@ cv::Mat decode_image_file(const std::string& path, int flags) {
     throw Error(
         path, "",
         fmt::format("{}, which glint does not read (convert it to PNG, TIFF or EXR)", *format));
+  if (is_radiance_hdr(bytes)) return decode_radiance_hdr(path, bytes, flags);
   cv::Mat image;
   OpenCvMessages messages;
   try {
-    if (is_hdr(bytes)) {
-      // OpenCV decodes Radiance HDR from memory through a temporary copy of the file, which it
-      // leaves behind when decoding fails: read the file itself instead.
-      image = cv::imread(path, flags);
-    } else {
-      const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8U,
-                           const_cast<char*>(bytes.data()));  // imdecode only reads it
-      image = cv::imdecode(buffer, flags);
-    }
+    const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8U,
+                         const_cast<char*>(bytes.data()));  // imdecode only reads it
+    image = cv::imdecode(buffer, flags);
   } catch (const cv::Exception& e) {
     throw Error(path, "", "cannot decode the image: " + e.err);
   }

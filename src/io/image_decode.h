@@ -25,7 +25,7 @@ void require_image_size_allowed(const std::string& path, std::string_view bytes)
 // before decoding), a GIS raster or DICOM file (which OpenCV would pass to GDAL or GDCM) or not
 // decodable. PNG goes through libpng with glint's own message
 // handlers (libpng's messages become part of the one error line, never a line of their own);
-// Radiance HDR is read from the file (no temporary copy).
+// Radiance HDR is decoded by io/radiance_hdr.h.
 cv::Mat decode_image_file(const std::string& path, int flags);
 
 }  // namespace glint::io
