@@ -49,6 +49,14 @@ class Reader {
   std::string_view bytes_;
 };
 
+// Header text for an error message: at most 40 bytes, anything but printable ASCII as '?'.
+std::string quoted(std::string_view text) {
+  std::string shown(text.substr(0, 40));
+  for (char& c : shown)
+    if (c < 0x20 || c > 0x7e) c = '?';
+  return "'" + shown + "'";
+}
+
 // The header: the magic line, variable lines ("FORMAT=32-bit_rle_rgbe" among them) up to a
 // blank line, then the resolution line. Only the standard orientation (rows top to bottom,
 // columns left to right) is read.
@@ -59,17 +67,19 @@ cv::Size read_header(Reader& reader, const std::string& path) {
        text = reader.line("the header")) {
     if (text.starts_with("FORMAT=")) {
       if (text != "FORMAT=32-bit_rle_rgbe")
-        reader.fail(fmt::format("pixel format '{}' is not supported (32-bit_rle_rgbe)",
-                                text.substr(7, 40)));
+        reader.fail(fmt::format("pixel format {} is not supported (32-bit_rle_rgbe)",
+                                quoted(text.substr(7))));
       rgbe_format = true;
     }
   }
   if (!rgbe_format) reader.fail("the header has no FORMAT=32-bit_rle_rgbe line");
-  const std::string resolution(reader.line("the resolution line").substr(0, 80));
+  std::string_view line = reader.line("the resolution line");
+  while (!line.empty() && (line.back() == ' ' || line.back() == '\r')) line.remove_suffix(1);
+  const std::string resolution(line.substr(0, 80));
   int height = 0, width = 0, used = 0;
   if (std::sscanf(resolution.c_str(), "-Y %d +X %d%n", &height, &width, &used) != 2 ||
       used != int(resolution.size()))
-    reader.fail(fmt::format("resolution line '{}' is not '-Y height +X width'", resolution));
+    reader.fail(fmt::format("resolution line {} is not '-Y height +X width'", quoted(line)));
   limits::check_image_size(width, height, path, "header");
   return {width, height};
 }

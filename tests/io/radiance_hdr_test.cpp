@@ -54,6 +54,7 @@ TEST(RadianceHdr, BadFilesAreOneLineAndLeaveNoDescriptorOpen) {
        "pixel format '32-bit_rle_xyze' is not supported (32-bit_rle_rgbe)"},
       {header + "+Y 4 +X 4\n", "resolution line '+Y 4 +X 4' is not '-Y height +X width'"},
       {header + "-Y 3 +X\xff\xff", "the file ends inside the resolution line"},
+      {header + "-Y 3 +X\x01z\n", "resolution line '-Y 3 +X?z' is not '-Y height +X width'"},
       {header + "-Y 1 +X 8\n" + run_start + "\x09", "scanline 0 has a run past its end"},
       {header + "-Y 1 +X 8\n" + std::string("\x02\x02\x00\x09", 4),
        "scanline 0 declares a width other than the image's"},
