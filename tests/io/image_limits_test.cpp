@@ -72,6 +72,36 @@ TEST(ImageLimits, ExrAttributeLargerThanTheFileIsRefusedBeforeDecoding) {
             "not a readable OpenEXR file: the header runs past the end of the file");
 }
 
+std::string little_endian(std::int32_t value) {
+  const auto bits = std::uint32_t(value);
+  return {char(bits), char(bits >> 8), char(bits >> 16), char(bits >> 24)};
+}
+
+// One OpenEXR header holding only a dataWindow of width x height, with its closing null byte.
+std::string exr_header(std::int32_t width, std::int32_t height) {
+  return std::string("dataWindow\0box2i\0", 17) + little_endian(16) + little_endian(0) +
+         little_endian(0) + little_endian(width - 1) + little_endian(height - 1) + '\0';
+}
+
+TEST(ImageLimits, EveryPartOfAMultiPartExrIsChecked) {
+  const std::string magic("\x76\x2f\x31\x01", 4);
+  const std::string multi_part = magic + little_endian(2 | 0x1000);
+  EXPECT_NO_THROW(require_image_size_allowed(
+      "two.exr", multi_part + exr_header(8, 4) + exr_header(16, 2) + '\0' + "offsets"));
+  const Error error = error_of([&] {
+    require_image_size_allowed(
+        "two.exr", multi_part + exr_header(8, 4) + exr_header(20000, 20000) + '\0' + "offsets");
+  });
+  EXPECT_THAT(error.reason(), HasSubstr("20000x20000 pixels"));
+  // A single-part file ends its header list after one header, whatever follows.
+  EXPECT_NO_THROW(require_image_size_allowed(
+      "one.exr", magic + little_endian(2) + exr_header(8, 4) + "\xff\xff\xff\x7f offsets"));
+  EXPECT_THAT(error_of([&] {
+                require_image_size_allowed("none.exr", magic + little_endian(2) + '\0');
+              }).reason(),
+              HasSubstr("a header has no dataWindow"));
+}
+
 // OpenCV would pass these to GDAL, which tries all of its drivers and prints on stderr, and to
 // GDCM, which aborts on some malformed DICOM files (an assertion; found by the image fuzz target,
 // fuzz/corpus/image/regression-dicom-gdcm-assertion).
