@@ -106,21 +106,6 @@ std::vector<Size> exr_part_sizes(const std::string& path, std::string_view bytes
   return sizes;
 }
 
-// Radiance HDR: header lines, a blank line, then "-Y height +X width" (or another orientation).
-std::optional<Size> hdr_size(std::string_view bytes) {
-  const std::size_t blank = bytes.find("\n\n");
-  if (blank == std::string_view::npos) return std::nullopt;
-  const std::size_t end = bytes.find('\n', blank + 2);
-  const std::string line(
-      bytes.substr(blank + 2, std::min<std::size_t>(end, 200 + blank) - blank - 2));
-  char first_axis = 0, second_axis = 0;
-  long long first = 0, second = 0;
-  if (std::sscanf(line.c_str(), "%*c%c %lld %*c%c %lld", &first_axis, &first, &second_axis,
-                  &second) != 4)
-    return std::nullopt;
-  return first_axis == 'Y' ? Size{second, first} : Size{first, second};
-}
-
 // The formats OpenCV hands to GDAL ("NITF" at byte 0, "DTED" at byte 140) or to GDCM ("DICM" at
 // byte 128; OpenCV's GdalDecoder / DICOMDecoder::checkSignature): GDAL tries every raster driver
 // it has and prints their complaints on stderr, GDCM aborts the process on some malformed files
@@ -132,12 +117,11 @@ std::optional<std::string_view> gis_or_medical_format(std::string_view bytes) {
   return std::nullopt;
 }
 
-// The image's size from its header, for the formats other than OpenEXR that say it there.
+// The image's size from a PNG or JPEG header.
 std::optional<Size> header_size(std::string_view bytes) {
   if (bytes.starts_with(kPngSignature) && bytes.size() >= 24 && bytes.substr(12, 4) == "IHDR")
     return Size{big_endian_32(bytes, 16), big_endian_32(bytes, 20)};
   if (bytes.starts_with("\xff\xd8\xff")) return jpeg_size(bytes);
-  if (is_radiance_hdr(bytes)) return hdr_size(bytes);
   return std::nullopt;
 }
 

@@ -85,9 +85,9 @@ NpyArray read_npy(const std::string& path) {
   const std::string dims = match[1];
   for (auto it = std::sregex_iterator(dims.begin(), dims.end(), extent_digits);
        it != std::sregex_iterator(); ++it) {
-    const std::string digits = it->str();
+    const char* digits = dims.data() + it->position();
     std::size_t extent = 0;
-    const auto parsed = std::from_chars(digits.data(), digits.data() + digits.size(), extent);
+    const auto parsed = std::from_chars(digits, digits + it->length(), extent);
     if (parsed.ec != std::errc() || (extent != 0 && count > (std::size_t(1) << 40) / extent))
       throw Error(path, "header", "shape is implausibly large");
     array.shape.push_back(extent);

@@ -76,12 +76,13 @@ cv::Size read_header(Reader& reader, const std::string& path) {
   std::string_view line = reader.line("the resolution line");
   while (!line.empty() && (line.back() == ' ' || line.back() == '\r')) line.remove_suffix(1);
   const std::string resolution(line.substr(0, 80));
-  int height = 0, width = 0, used = 0;
-  if (std::sscanf(resolution.c_str(), "-Y %d +X %d%n", &height, &width, &used) != 2 ||
+  long long height = 0, width = 0;
+  int used = 0;
+  if (std::sscanf(resolution.c_str(), "-Y %lld +X %lld%n", &height, &width, &used) != 2 ||
       used != int(resolution.size()))
     reader.fail(fmt::format("resolution line {} is not '-Y height +X width'", quoted(line)));
   limits::check_image_size(width, height, path, "header");
-  return {width, height};
+  return {int(width), int(height)};
 }
 
 // One scanline in the adaptive run-length form: each of the four components in turn as runs
