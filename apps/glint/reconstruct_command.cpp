@@ -240,6 +240,8 @@ void run_reconstruct(ReconstructOptions options) {
          {"albedo_average", reflectance::albedo_average_name(options.params.albedo_average)},
          {"albedo_keep_clipped", options.params.albedo_keep_clipped},
          {"albedo_min_light_cosine", options.params.albedo_min_light_cosine},
+         {"albedo_max_ratio", options.params.albedo_max_ratio},
+         {"albedo_max_indirect_share", options.params.albedo_max_indirect_share},
          {"albedo_smoothing", options.params.albedo_smoothing},
          {"specular", specular_name(options.params.specular)},
          {"normals", normals_name(options.params.observations)},
@@ -386,6 +388,31 @@ void register_reconstruct_command(CLI::App& app) {
                    "blend in the segment's refined albedo as one more voxel lit at this cosine, "
                    "and weigh each voxel by its light (0 = trust all and no segment albedo, as "
                    "the paper)")
+      ->check(CLI::Range(0.0f, 1.0f))
+      ->capture_default_str();
+  command
+      ->add_option("--albedo-max-ratio", params.albedo_max_ratio,
+                   "Distrust a voxel's refined albedo where it is more than this factor below or "
+                   "above the median of its segment's: the lights do not explain its "
+                   "observations, most often a shadow cast by a part of the scene the camera "
+                   "never saw (the shadow ray passes through it); the re-renderings and the mesh "
+                   "use the reliable voxels around it or the segment's albedo instead (0 = trust "
+                   "all, as the paper)")
+      ->check(CLI::Validator(
+          [](const std::string& text) -> std::string {
+            char* end = nullptr;
+            const float ratio = std::strtof(text.c_str(), &end);
+            const bool valid = end != text.c_str() && *end == '\0' && (ratio == 0 || ratio >= 1);
+            return valid ? "" : "must be 0 (off) or a number >= 1, not " + text;
+          },
+          "0 or >= 1"))
+      ->capture_default_str();
+  command
+      ->add_option("--albedo-max-indirect", params.albedo_max_indirect_share,
+                   "With --indirect on: distrust a voxel's refined albedo where more than this "
+                   "share of its irradiance is the gathered indirect light (an estimate whose "
+                   "error then dominates: mostly voxels in shadow); they take the albedo of the "
+                   "reliable voxels around them or their segment's (1 = trust all)")
       ->check(CLI::Range(0.0f, 1.0f))
       ->capture_default_str();
   command

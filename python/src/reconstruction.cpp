@@ -149,6 +149,10 @@ reflectance::ReflectanceParams params_from(const py::dict& options, std::string&
       p.albedo_keep_clipped = value.cast<bool>();
     } else if (name == "albedo_min_cosine") {
       p.albedo_min_light_cosine = value.cast<float>();
+    } else if (name == "albedo_max_indirect") {
+      p.albedo_max_indirect_share = value.cast<float>();
+    } else if (name == "albedo_max_ratio") {
+      p.albedo_max_ratio = value.cast<float>();
     } else if (name == "albedo_smoothing") {
       p.albedo_smoothing = value.cast<float>();
     } else if (name == "specular") {

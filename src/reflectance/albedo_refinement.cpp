@@ -189,6 +189,7 @@ std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int 
   // Eq. (7) per observation and channel.
   RefinedAlbedo refined;
   refined.light_tangent = sines / cosines;
+  refined.indirect_share = lighting.indirect.mean() / cosines;
   std::array<Channels, std::max(kMaxObservationsPerVoxel, kNetworkSize)> values;
   for (int j = 0; j < used; ++j) {
     values[j] = Channels{};

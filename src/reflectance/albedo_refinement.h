@@ -42,6 +42,8 @@ struct RefinedAlbedo {
   // and a normal tilted by d changes that by about t d: under grazing light (cosine 0.2, t ~ 5)
   // a 2-degree tilt is a 17 % error in kd.
   float light_tangent = 0.0f;
+  // The gathered indirect light's share of the irradiance eq. (7) divided by (by luminance).
+  float indirect_share = 0.0f;
   float light_cosine() const { return 1.0f / std::sqrt(1.0f + light_tangent * light_tangent); }
 };
 
@@ -55,6 +57,16 @@ inline float refined_albedo_weight(float light_tangent) {
 }
 // The tangent of the angle whose cosine is `cosine` in [0, 1] (infinite at 0).
 inline float tangent_of(float cosine) { return std::sqrt(1 - cosine * cosine) / cosine; }
+
+// Whether a voxel's refined albedo is within a factor max_ratio (>= 1) of its segment's
+// reference albedo, both as their largest channel (a shadow dims every channel; a red patch on a
+// grey segment keeps one bright): beyond it the light model does not explain
+// the voxel's observations (ReflectanceParams::albedo_max_ratio). max_ratio 0, or no reference
+// (NaN), accepts every albedo.
+inline bool explained_by_light(float refined, float reference, float max_ratio) {
+  if (max_ratio == 0 || std::isnan(reference)) return true;
+  return refined * max_ratio >= reference && refined <= reference * max_ratio;
+}
 
 // Eq. (7) over the voxel's observations under `lighting` (the lights that reach it, its
 // indirect irradiance) (those seen from above the surface, at most

@@ -28,7 +28,8 @@ WardShading ward_shading(float alpha, const Eigen::Vector3f& p, const Eigen::Vec
     const Eigen::Vector3f wi = to_light / std::sqrt(distance2);
     const float cos_i = n.dot(wi);
     if (cos_i <= 0) continue;
-    const Eigen::Vector3f irradiance = light.intensity * (cos_i / distance2);
+    const Eigen::Vector3f irradiance =
+        light.intensity * (lighting.direct_share * cos_i / distance2);
     shading.diffuse += irradiance;
     shading.specular += irradiance * render::ward_specular_lobe(n, wi, wo, alpha);
   }
@@ -86,6 +87,12 @@ Cell cell_of(const ObservationGrid& grid, const Eigen::Vector3f& p) {
   const Eigen::Vector3i base(int(std::floor(g.x())), int(std::floor(g.y())),
                              int(std::floor(g.z())));
   return {base, g - base.cast<float>()};
+}
+
+// The trilinear weight of corner c (bit 0: +x, bit 1: +y, bit 2: +z) at t in the cell.
+float corner_weight(int c, const Eigen::Vector3f& t) {
+  return ((c & 1) ? t.x() : 1 - t.x()) * (((c >> 1) & 1) ? t.y() : 1 - t.y()) *
+         (((c >> 2) & 1) ? t.z() : 1 - t.z());
 }
 
 // Fills `around`'s voxels for the cell at `base`, unless it holds them already.
@@ -229,9 +236,7 @@ bool interpolate(const RefinedNeighbourhood& around, const Eigen::Vector3f& t, E
   const auto add_corners = [&](const RefinedNeighbourhood::Corners& corners) {
     for (int i = 0; i < corners.count; ++i) {
       const int c = corners.corner[std::size_t(i)];
-      const float weight = ((c & 1) ? t.x() : 1 - t.x()) * (((c >> 1) & 1) ? t.y() : 1 - t.y()) *
-                           (((c >> 2) & 1) ? t.z() : 1 - t.z());
-      const float w = weight * corners.weight[std::size_t(i)];
+      const float w = corner_weight(c, t) * corners.weight[std::size_t(i)];
       sum += w * corners.kd[std::size_t(i)];
       total += w;
     }
@@ -344,6 +349,25 @@ int segment_at(const ObservationGrid& grid, const Eigen::Vector3f& p,
 
 }  // namespace
 
+namespace {
+
+// ObservationGrid::light_shortfall at the point at t in the cell of `around`: trilinear over the
+// cell's corners of the segment with a refined albedo; 0 without any.
+float interpolate_shortfall(const ObservationGrid& grid, const RefinedNeighbourhood& around,
+                            const Eigen::Vector3f& t) {
+  float sum = 0, total = 0;
+  for (int c = 0; c < 8; ++c) {
+    const int v = voxel_at(around, c & 1, (c >> 1) & 1, (c >> 2) & 1);
+    if (v < 0) continue;
+    const float weight = corner_weight(c, t);
+    sum += weight * grid.light_shortfall(v);
+    total += weight;
+  }
+  return total > 1e-6f ? sum / total : 0.0f;
+}
+
+}  // namespace
+
 bool MaterialLookup::operator()(const Eigen::Vector3f& p, PointMaterial& material) {
   const Cell cell = cell_of(grid_, p);
   look_up(grid_, cell.base, around_, &blocks_);
@@ -354,6 +378,7 @@ bool MaterialLookup::operator()(const Eigen::Vector3f& p, PointMaterial& materia
   if (fused->kd_refined) material.refined.kd = *fused->kd_refined;
   select_segment(grid_, material.segment, around_);
   interpolate(around_, cell.t, material.refined.kd, !fused->kd_refined, blend_);
+  material.direct_share = 1 - interpolate_shortfall(grid_, around_, cell.t);
   return true;
 }
 
@@ -418,8 +443,9 @@ void render_material_maps(const fusion::SurfaceView& surface, const Pose& camera
         return (radiance * exposure).cwiseMax(0.0f).cwiseMin(1.0f).eval();
       };
       // The two materials differ in kd only: one shading serves both.
-      const WardShading shading = ward_shading(material.fused.alpha, p, n, eye, lights,
-                                               lighting ? (*lighting)(p, n) : PointLighting{});
+      PointLighting light_here = lighting ? (*lighting)(p, n) : PointLighting{};
+      light_here.direct_share = material.direct_share;
+      const WardShading shading = ward_shading(material.fused.alpha, p, n, eye, lights, light_here);
       put(maps.rgb, x, y, pixel(shading.radiance(material.fused)));
       put(maps.rgb_refined, x, y, pixel(shading.radiance(material.refined)));
     }

@@ -121,6 +121,10 @@ struct RefinedNeighbourhood {
 struct PointMaterial {
   int segment = 0;
   render::WardMaterial fused, refined;
+  // The share of the direct light its voxels' observations showed (1 - their
+  // ObservationGrid::light_shortfall, trilinear over the cell's voxels of the segment with a
+  // refined albedo): PointLighting::direct_share of a re-rendering.
+  float direct_share = 1;
 };
 
 // The material at surface point p: the segment of the voxel holding p (else of the nearest

@@ -226,6 +226,7 @@ ObservationGrid::ObservationGrid(const ObservationGridParams& params)
   has_refined_kd_ = voxel_pool<bool>(voxels);
   refined_kd_reliable_ = voxel_pool<bool>(voxels);
   refined_kd_light_tangent_ = voxel_pool<float>(voxels);
+  light_shortfall_ = voxel_pool<float>(voxels);
   block_last_frame_ = std::make_unique<std::atomic<int>[]>(hash_.capacity());
   for (std::size_t i = 0; i < hash_.capacity(); ++i) block_last_frame_[i] = -1;
 }

@@ -149,6 +149,13 @@ class ObservationGrid {
   // set), which weighs the voxel among its neighbours (refined_albedo_weight).
   float& refined_kd_light_tangent(int v) { return refined_kd_light_tangent_[v]; }
   float refined_kd_light_tangent(int v) const { return refined_kd_light_tangent_[v]; }
+  // The share of the reaching lights' direct light that the voxel's observations lack, in
+  // [0, 1]: 0 where eq. (7) explains them, else 1 - (its refined albedo over its segment's, by
+  // their largest channels) where that albedo is too dark to trust
+  // (ReflectanceParams::albedo_max_ratio), a shadow the fused geometry cannot cast. Re-renderings
+  // dim the direct light there by it.
+  float& light_shortfall(int v) { return light_shortfall_[v]; }
+  float light_shortfall(int v) const { return light_shortfall_[v]; }
 
   // Look-ups of many nearby voxels (a rendering's pixels, a mesh's vertices) may keep the
   // blocks they found in a cache of their own (one per thread), which spares most hash look-ups.
@@ -265,7 +272,7 @@ class ObservationGrid {
   PoolArray<std::int32_t> segment_;
   PoolArray<std::int16_t> segment_confidence_;
   PoolArray<bool> has_refined_kd_, refined_kd_reliable_;
-  PoolArray<float> refined_kd_light_tangent_;
+  PoolArray<float> refined_kd_light_tangent_, light_shortfall_;
 
   std::vector<VisibleVoxel> visible_;
   // collect()'s scratch: per frame block, voxels_per_block_ entries of which the first

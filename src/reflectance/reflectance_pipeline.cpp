@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numeric>
 #include <string>
 
 #include "core/error.h"
@@ -58,6 +59,10 @@ ReflectancePipeline::ReflectancePipeline(const Intrinsics& intrinsics,
     throw Error("reflectance pipeline", "albedo_refresh_frames", "must be >= 1");
   if (!(params.albedo_min_light_cosine >= 0 && params.albedo_min_light_cosine <= 1))
     throw Error("reflectance pipeline", "albedo_min_light_cosine", "must be in [0, 1]");
+  if (!(params.albedo_max_ratio == 0 || params.albedo_max_ratio >= 1))
+    throw Error("reflectance pipeline", "albedo_max_ratio", "must be 0 (off) or >= 1");
+  if (!(params.albedo_max_indirect_share >= 0 && params.albedo_max_indirect_share <= 1))
+    throw Error("reflectance pipeline", "albedo_max_indirect_share", "must be in [0, 1]");
   if (!(params.albedo_smoothing >= 0 && std::isfinite(params.albedo_smoothing)))
     throw Error("reflectance pipeline", "albedo_smoothing", "must be finite and >= 0");
   if (lights_.empty())
@@ -76,19 +81,14 @@ void ReflectancePipeline::refine_albedo_of_visible() {
   // with its data in cache), so each chunk runs a two-stage prefetch: a voxel's own state
   // kVoxelAhead iterations early, then, once that has arrived, its observations.
   constexpr std::size_t kVoxelAhead = 8, kObservationsAhead = 3;
-  // Per thread and segment: the sum of the reliable refined kd (rgb) and their count. The sums
-  // are in fixed point (kd in [0, 1] in steps of 2^-24), so that they add up to the same total
-  // whichever thread took which voxels: a run's result does not depend on the scheduling.
-  using FixedSums = Eigen::Matrix<std::int64_t, 4, 1>;
-  constexpr double kFixedOne = double(1 << 24);
   const int segments = segment_map_.max_segment_id() + 1;
-  tbb::enumerable_thread_specific<std::vector<FixedSums>> sums(std::size_t(segments),
-                                                               FixedSums::Zero());
   // Observations at or above this radiance have clipped (refine_albedo() leaves them out).
   const float clipped =
       params_.albedo_keep_clipped ? INFINITY : saturated_radiance(params_.exposure);
+  // Eq. (7) per due voxel; the largest channel of its albedo where the light it was
+  // solved under can be trusted (not grazing, not mostly the gathered indirect light), else NaN.
+  due_albedo_.assign(albedo_due_.size(), NAN);
   parallel_for_chunks(albedo_due_.size(), 64, [&](std::size_t begin, std::size_t end) {
-    std::vector<FixedSums>& segment_sums = sums.local();
     for (std::size_t i = begin; i < std::min(begin + kVoxelAhead, end); ++i)
       grid_.prefetch_voxel(albedo_due_[i]);
     for (std::size_t i = begin; i < end; ++i) {
@@ -96,8 +96,7 @@ void ReflectancePipeline::refine_albedo_of_visible() {
       if (i + kObservationsAhead < end)
         grid_.prefetch_observations(albedo_due_[i + kObservationsAhead], false);
       const int v = albedo_due_[i];
-      const int segment = grid_.segment(v);
-      const SegmentMaterial* material = specular_.material(segment);
+      const SegmentMaterial* material = specular_.material(grid_.segment(v));
       if (!material) continue;
       const auto refined =
           refine_albedo(grid_.observations(v), grid_.observation_count(v), grid_.position(v),
@@ -105,16 +104,44 @@ void ReflectancePipeline::refine_albedo_of_visible() {
                         params_.albedo_average, clipped, transport_.lighting(v));
       // Each voxel is written by one iteration only: the due list holds it once.
       grid_.has_refined_kd(v) = refined.has_value();
+      grid_.refined_kd_reliable(v) = false;
+      grid_.light_shortfall(v) = 0;
       if (!refined) continue;
       grid_.refined_kd(v) = refined->kd.cwiseMax(0.0f).cwiseMin(1.0f);
-      grid_.refined_kd_reliable(v) = refined->light_cosine() >= params_.albedo_min_light_cosine;
       grid_.refined_kd_light_tangent(v) = refined->light_tangent;
-      if (grid_.refined_kd_reliable(v) && segment < segments) {
-        const Eigen::Vector3f& kd = grid_.refined_kd(v);
-        segment_sums[segment] +=
-            FixedSums(std::llround(kd.x() * kFixedOne), std::llround(kd.y() * kFixedOne),
-                      std::llround(kd.z() * kFixedOne), 1);
+      if (refined->light_cosine() >= params_.albedo_min_light_cosine &&
+          refined->indirect_share <= params_.albedo_max_indirect_share)
+        due_albedo_[i] = grid_.refined_kd(v).maxCoeff();
+    }
+  });
+  update_albedo_references(segments);
+
+  // Per thread and segment: the sum of the reliable refined kd (rgb) and their count. The sums
+  // are in fixed point (kd in [0, 1] in steps of 2^-24), so that they add up to the same total
+  // whichever thread took which voxels: a run's result does not depend on the scheduling.
+  using FixedSums = Eigen::Matrix<std::int64_t, 4, 1>;
+  constexpr double kFixedOne = double(1 << 24);
+  tbb::enumerable_thread_specific<std::vector<FixedSums>> sums(std::size_t(segments),
+                                                               FixedSums::Zero());
+  // Reliable: solved under trusted light, and explained by the lights against its segment's
+  // reference albedo; the unexplained keep their shortfall of light.
+  parallel_for_chunks(albedo_due_.size(), 256, [&](std::size_t begin, std::size_t end) {
+    std::vector<FixedSums>& segment_sums = sums.local();
+    for (std::size_t i = begin; i < end; ++i) {
+      const int v = albedo_due_[i];
+      const int segment = grid_.segment(v);
+      if (!grid_.has_refined_kd(v) || segment < 1 || segment >= segments) continue;
+      const Eigen::Vector3f& kd = grid_.refined_kd(v);
+      const float reference = albedo_reference_[std::size_t(segment)];
+      if (!explained_by_light(kd.maxCoeff(), reference, params_.albedo_max_ratio)) {
+        grid_.light_shortfall(v) = std::max(0.0f, 1 - kd.maxCoeff() / reference);
+        continue;
       }
+      if (std::isnan(due_albedo_[i])) continue;
+      grid_.refined_kd_reliable(v) = true;
+      segment_sums[segment] +=
+          FixedSums(std::llround(kd.x() * kFixedOne), std::llround(kd.y() * kFixedOne),
+                    std::llround(kd.z() * kFixedOne), 1);
     }
   });
   // Each segment's mean over its voxels solved reliably in this frame, into its
@@ -125,6 +152,36 @@ void ReflectancePipeline::refine_albedo_of_visible() {
     if (sum.w() > 0)
       specular_.fuse_refined_albedo(
           segment, (sum.head<3>().cast<double>() / (kFixedOne * double(sum.w()))).cast<float>());
+  }
+}
+
+void ReflectancePipeline::update_albedo_references(int segments) {
+  // The trusted albedos of this frame's due voxels, bucketed by segment (a counting sort).
+  segment_starts_.assign(std::size_t(segments) + 1, 0);
+  const auto segment_of = [&](std::size_t i) {
+    const int segment = grid_.segment(albedo_due_[i]);
+    return std::isnan(due_albedo_[i]) || segment < 1 || segment >= segments ? -1 : segment;
+  };
+  for (std::size_t i = 0; i < albedo_due_.size(); ++i)
+    if (const int segment = segment_of(i); segment > 0) ++segment_starts_[std::size_t(segment)];
+  std::exclusive_scan(segment_starts_.begin(), segment_starts_.end(), segment_starts_.begin(), 0);
+  by_segment_.resize(std::size_t(segment_starts_.back()));
+  segment_fill_.assign(segment_starts_.begin(), segment_starts_.end() - 1);
+  for (std::size_t i = 0; i < albedo_due_.size(); ++i)
+    if (const int segment = segment_of(i); segment > 0)
+      by_segment_[std::size_t(segment_fill_[std::size_t(segment)]++)] = due_albedo_[i];
+  albedo_reference_.resize(std::size_t(segments), NAN);
+  for (int segment = 1; segment < segments; ++segment) {
+    const auto first = by_segment_.begin() + segment_starts_[std::size_t(segment)];
+    const auto last = by_segment_.begin() + segment_starts_[std::size_t(segment) + 1];
+    float& reference = albedo_reference_[std::size_t(segment)];
+    if (last - first >= kMinReferenceVoxels) {
+      std::nth_element(first, first + (last - first) / 2, last);
+      reference = *(first + (last - first) / 2);
+    } else if (std::isnan(reference)) {
+      if (const SegmentMaterial* material = specular_.material(segment))
+        reference = material->ward.kd.maxCoeff();
+    }
   }
 }
 

@@ -67,6 +67,20 @@ struct ReflectanceParams {
   // It also sets the weight of the segment's refined albedo in the blend (albedo_blend()).
   // 0 trusts every voxel and blends in no segment albedo, as the paper does.
   float albedo_min_light_cosine = 0.2f;
+  // A voxel whose refined albedo (its largest channel) is under 1/this of its segment's
+  // reference albedo (update_albedo_references()), or over this times it, is unreliable too: the
+  // image model does not explain its observations. The usual cause is a shadow the fused geometry
+  // cannot cast, because the occluder's far side was never in view, so the shadow ray passes
+  // through it and eq. (7) divides a black pixel by a light that never reached it. 3 was set before
+  // measuring: a shadow leaves the indirect light, well under a third of the direct, and few
+  // textures reach a third of their mean. 0 trusts such voxels, as the paper.
+  float albedo_max_ratio = 3.0f;
+  // A voxel whose irradiance is more than this share gathered indirect light is unreliable too:
+  // the gather is an estimate (emitters taken as diffuse, surfaces never seen as dark, 64 rays
+  // of Monte Carlo noise), and where it is most of what eq. (7) divides by, its error is most of
+  // the albedo's. Such voxels, mostly in shadow, take the albedo of their lit neighbours or
+  // segment instead. 0.5 was set before measuring; 1 trusts them all.
+  float albedo_max_indirect_share = 0.5f;
   // Re-renderings and the mesh smooth the refined albedo between neighbouring voxels that agree
   // to about this relative contrast (interpolate_refined_kd in reflectance/material_maps.h);
   // 0 interpolates trilinearly only, as the paper. On a uniform surface a voxel's eq. (7) albedo
@@ -138,7 +152,21 @@ class ReflectancePipeline {
   LightTransport transport_;
   std::vector<render::PointLight> lights_;
   StageTimings timings_;
-  std::vector<int> albedo_due_;  // scratch of refine_albedo_of_visible()
+  // Each segment's reference albedo for the test of explained_by_light(), as its largest
+  // channel: the median over a frame's due voxels of their albedos solved under trusted light,
+  // where the segment has at least kMinReferenceVoxels of them; else its last one; before any,
+  // its HemiCNN albedo's. A median, since the voxels in shadows the geometry cannot cast are a
+  // minority of a segment, and the network's albedo can be off by more than the ratio (a dark
+  // object read as grey).
+  void update_albedo_references(int segments);
+  static constexpr int kMinReferenceVoxels = 16;
+
+  // Scratch of refine_albedo_of_visible(): the due voxels, their trusted albedos (NaN: none),
+  // and the counting sort of those by segment.
+  std::vector<int> albedo_due_;
+  std::vector<float> due_albedo_, by_segment_;
+  std::vector<int> segment_starts_, segment_fill_;
+  std::vector<float> albedo_reference_;  // per segment id; NaN: none yet
   int frame_ = 0;
 };
 

@@ -208,6 +208,20 @@ TEST(AlbedoRefinement, GrazingLightWeighsAnAlbedoByTheInverseOfItsVariance) {
   EXPECT_NEAR(refined_albedo_weight(3.0f), 1.0f / 9, 1e-7f);
 }
 
+TEST(AlbedoRefinement, AnAlbedoMoreThanTheRatioFromItsSegmentsIsNotExplainedByTheLights) {
+  // Within a factor 3 either way of the segment's 0.4: explained.
+  EXPECT_TRUE(explained_by_light(0.134f, 0.4f, 3));
+  EXPECT_TRUE(explained_by_light(1.0f, 0.4f, 3));
+  // A shadowed voxel read as lit: under a third of the segment's.
+  EXPECT_FALSE(explained_by_light(0.13f, 0.4f, 3));
+  EXPECT_FALSE(explained_by_light(0.0f, 0.4f, 3));
+  // More than three times as bright.
+  EXPECT_FALSE(explained_by_light(0.5f, 0.12f, 3));
+  // Ratio 0, or no reference yet: everything, as the paper.
+  EXPECT_TRUE(explained_by_light(0.0f, 0.4f, 0));
+  EXPECT_TRUE(explained_by_light(0.0f, NAN, 3));
+}
+
 TEST(AlbedoRefinement, UnlitOrUnseenVoxelsHaveNoEstimate) {
   std::vector<render::PointLight> below(1);
   below[0].position = {0, -1, 0};

@@ -326,6 +326,52 @@ TEST(MaterialMaps, SegmentsRefinedAlbedoStandsAloneOrAsOneMoreVoxelAndKeptLookup
   EXPECT_GT(missing, 3);
 }
 
+// Voxels whose observations lack three quarters of the direct light (a shadow cast by a part of
+// the scene the camera never saw): the re-rendering's direct light is a quarter there, its
+// indirect light whole, and whole again away from them.
+TEST(MaterialMaps, AShadowTheGeometryCannotCastDimsTheDirectLightWhereItWasObserved) {
+  Wall wall;
+  ObservationGrid& grid = wall.grid();
+  WallMaterial wall_material(wall);
+  const Eigen::Vector3f p(0.013f, -0.007f, 1.005f);
+  const auto in_shadow = [&](const Eigen::Vector3f& q) { return (q - p).head<2>().norm() < 0.05f; };
+  wall.with_albedo([](const Eigen::Vector3f&) { return Eigen::Vector3f::Constant(0.4f); });
+  for (const VisibleVoxel& seen : wall.visible())
+    grid.light_shortfall(seen.voxel) = in_shadow(grid.position(seen.voxel)) ? 0.75f : 0.0f;
+  MaterialLookup lookup(grid, wall_material.estimator);
+  PointMaterial material;
+  ASSERT_TRUE(lookup(p, material));
+  EXPECT_NEAR(material.direct_share, 0.25f, 1e-6f);
+  ASSERT_TRUE(lookup(Eigen::Vector3f(0.1f, 0.05f, 1.005f), material));
+  EXPECT_NEAR(material.direct_share, 1.0f, 1e-6f);
+  // Halfway between a shadowed and a lit voxel centre: half the shortfall.
+  Eigen::Vector3f edge = p;
+  for (const VisibleVoxel& seen : wall.visible()) {
+    const Eigen::Vector3f& q = grid.position(seen.voxel);
+    if (in_shadow(q) && !in_shadow(q + Eigen::Vector3f(0.02f, 0, 0)) && std::abs(q.y()) < 0.02f)
+      edge = grid.voxel_centre(grid.voxel_coordinates(seen.voxel)) + Eigen::Vector3f(0.01f, 0, 0);
+  }
+  edge.z() = 1.005f;
+  ASSERT_TRUE(lookup(edge, material));
+  EXPECT_NEAR(material.direct_share, 1 - 0.75f / 2, 1e-5f);
+
+  render::WardMaterial m;
+  m.kd = {0.4f, 0.4f, 0.4f};
+  m.ks = {0.1f, 0.1f, 0.1f};
+  m.alpha = 0.2f;
+  std::vector<render::PointLight> lights(1);
+  lights[0].position = {0.3f, 0.2f, 0};
+  lights[0].intensity = {2, 2, 2};
+  const Eigen::Vector3f n(0, 0, -1), eye(0, 0, 0);
+  PointLighting lighting{.indirect = Eigen::Vector3f(0.1f, 0.2f, 0.3f)};
+  const WardShading whole = ward_shading(m.alpha, p, n, eye, lights, lighting);
+  lighting.direct_share = 0.25f;
+  const WardShading dimmed = ward_shading(m.alpha, p, n, eye, lights, lighting);
+  EXPECT_TRUE((dimmed.diffuse - lighting.indirect)
+                  .isApprox(0.25f * (whole.diffuse - lighting.indirect), 1e-6f));
+  EXPECT_TRUE(dimmed.specular.isApprox(0.25f * whole.specular, 1e-6f));
+}
+
 TEST(MaterialMaps, RenderingIntoUsedMapsGivesWhatFreshMapsGive) {
   Wall wall;
   WallMaterial wall_material(wall);
