@@ -4,9 +4,10 @@
 // segment and that segment's fused Ward material; the refined diffuse albedo is interpolated
 // trilinearly between the surrounding observation voxels of the same segment (§3.7), and
 // optionally smoothed where neighbouring voxels agree to within the scatter of eq. (7); each
-// pixel is shaded with the Ward BRDF under the estimated near-field point lights (direct light,
-// no shadows, as the albedo refinement assumes), once with the HemiCNN's kd and once with the
-// refined kd.
+// pixel is shaded with the Ward BRDF under the estimated near-field point lights (with the light
+// transport's shadows and indirect light where they are on, and the direct light dimmed where
+// the voxels' observations lacked it: PointMaterial::direct_share), once with the HemiCNN's kd
+// and once with the refined kd.
 #include <array>
 #include <cmath>
 #include <cstdint>

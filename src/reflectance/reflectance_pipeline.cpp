@@ -81,14 +81,27 @@ void ReflectancePipeline::refine_albedo_of_visible() {
   // with its data in cache), so each chunk runs a two-stage prefetch: a voxel's own state
   // kVoxelAhead iterations early, then, once that has arrived, its observations.
   constexpr std::size_t kVoxelAhead = 8, kObservationsAhead = 3;
+  // Per thread and segment: the sum of the reliable refined kd (rgb) and their count. The sums
+  // are in fixed point (kd in [0, 1] in steps of 2^-24), so that they add up to the same total
+  // whichever thread took which voxels: a run's result does not depend on the scheduling.
+  using FixedSums = Eigen::Matrix<std::int64_t, 4, 1>;
+  constexpr double kFixedOne = double(1 << 24);
   const int segments = segment_map_.max_segment_id() + 1;
+  tbb::enumerable_thread_specific<std::vector<FixedSums>> sums(std::size_t(segments),
+                                                               FixedSums::Zero());
   // Observations at or above this radiance have clipped (refine_albedo() leaves them out).
   const float clipped =
       params_.albedo_keep_clipped ? INFINITY : saturated_radiance(params_.exposure);
-  // Eq. (7) per due voxel; the largest channel of its albedo where the light it was
-  // solved under can be trusted (not grazing, not mostly the gathered indirect light), else NaN.
-  due_albedo_.assign(albedo_due_.size(), NAN);
+  // The references of the frames before (update_albedo_references()); a segment without one
+  // yet is measured against its HemiCNN albedo.
+  albedo_reference_.resize(std::size_t(segments), NAN);
+  // Per due voxel, the largest channel of its albedo where the light it was solved under can be
+  // trusted (not grazing, not mostly the gathered indirect light), and its segment, else -1:
+  // this frame's contribution to the references.
+  due_albedo_.resize(albedo_due_.size());
+  due_segment_.assign(albedo_due_.size(), -1);
   parallel_for_chunks(albedo_due_.size(), 64, [&](std::size_t begin, std::size_t end) {
+    std::vector<FixedSums>& segment_sums = sums.local();
     for (std::size_t i = begin; i < std::min(begin + kVoxelAhead, end); ++i)
       grid_.prefetch_voxel(albedo_due_[i]);
     for (std::size_t i = begin; i < end; ++i) {
@@ -96,7 +109,8 @@ void ReflectancePipeline::refine_albedo_of_visible() {
       if (i + kObservationsAhead < end)
         grid_.prefetch_observations(albedo_due_[i + kObservationsAhead], false);
       const int v = albedo_due_[i];
-      const SegmentMaterial* material = specular_.material(grid_.segment(v));
+      const int segment = grid_.segment(v);
+      const SegmentMaterial* material = specular_.material(segment);
       if (!material) continue;
       const auto refined =
           refine_albedo(grid_.observations(v), grid_.observation_count(v), grid_.position(v),
@@ -107,43 +121,31 @@ void ReflectancePipeline::refine_albedo_of_visible() {
       grid_.refined_kd_reliable(v) = false;
       grid_.light_shortfall(v) = 0;
       if (!refined) continue;
-      grid_.refined_kd(v) = refined->kd.cwiseMax(0.0f).cwiseMin(1.0f);
+      const Eigen::Vector3f kd = refined->kd.cwiseMax(0.0f).cwiseMin(1.0f);
+      grid_.refined_kd(v) = kd;
       grid_.refined_kd_light_tangent(v) = refined->light_tangent;
-      if (refined->light_cosine() >= params_.albedo_min_light_cosine &&
-          refined->indirect_share <= params_.albedo_max_indirect_share)
-        due_albedo_[i] = grid_.refined_kd(v).maxCoeff();
-    }
-  });
-  update_albedo_references(segments);
-
-  // Per thread and segment: the sum of the reliable refined kd (rgb) and their count. The sums
-  // are in fixed point (kd in [0, 1] in steps of 2^-24), so that they add up to the same total
-  // whichever thread took which voxels: a run's result does not depend on the scheduling.
-  using FixedSums = Eigen::Matrix<std::int64_t, 4, 1>;
-  constexpr double kFixedOne = double(1 << 24);
-  tbb::enumerable_thread_specific<std::vector<FixedSums>> sums(std::size_t(segments),
-                                                               FixedSums::Zero());
-  // Reliable: solved under trusted light, and explained by the lights against its segment's
-  // reference albedo; the unexplained keep their shortfall of light.
-  parallel_for_chunks(albedo_due_.size(), 256, [&](std::size_t begin, std::size_t end) {
-    std::vector<FixedSums>& segment_sums = sums.local();
-    for (std::size_t i = begin; i < end; ++i) {
-      const int v = albedo_due_[i];
-      const int segment = grid_.segment(v);
-      if (!grid_.has_refined_kd(v) || segment < 1 || segment >= segments) continue;
-      const Eigen::Vector3f& kd = grid_.refined_kd(v);
-      const float reference = albedo_reference_[std::size_t(segment)];
+      const bool trusted_light = refined->light_cosine() >= params_.albedo_min_light_cosine &&
+                                 refined->indirect_share <= params_.albedo_max_indirect_share;
+      const bool in_map = segment > 0 && segment < segments;
+      if (trusted_light && in_map) {
+        due_albedo_[i] = kd.maxCoeff();
+        due_segment_[i] = segment;
+      }
+      const bool known = in_map && !std::isnan(albedo_reference_[std::size_t(segment)]);
+      const float reference =
+          known ? albedo_reference_[std::size_t(segment)] : material->ward.kd.maxCoeff();
       if (!explained_by_light(kd.maxCoeff(), reference, params_.albedo_max_ratio)) {
         grid_.light_shortfall(v) = std::max(0.0f, 1 - kd.maxCoeff() / reference);
         continue;
       }
-      if (std::isnan(due_albedo_[i])) continue;
-      grid_.refined_kd_reliable(v) = true;
-      segment_sums[segment] +=
-          FixedSums(std::llround(kd.x() * kFixedOne), std::llround(kd.y() * kFixedOne),
-                    std::llround(kd.z() * kFixedOne), 1);
+      grid_.refined_kd_reliable(v) = trusted_light;
+      if (trusted_light && in_map)
+        segment_sums[segment] +=
+            FixedSums(std::llround(kd.x() * kFixedOne), std::llround(kd.y() * kFixedOne),
+                      std::llround(kd.z() * kFixedOne), 1);
     }
   });
+  update_albedo_references(segments);
   // Each segment's mean over its voxels solved reliably in this frame, into its
   // SegmentMaterial::kd_refined.
   for (int segment = 1; segment < segments; ++segment) {
@@ -158,30 +160,20 @@ void ReflectancePipeline::refine_albedo_of_visible() {
 void ReflectancePipeline::update_albedo_references(int segments) {
   // The trusted albedos of this frame's due voxels, bucketed by segment (a counting sort).
   segment_starts_.assign(std::size_t(segments) + 1, 0);
-  const auto segment_of = [&](std::size_t i) {
-    const int segment = grid_.segment(albedo_due_[i]);
-    return std::isnan(due_albedo_[i]) || segment < 1 || segment >= segments ? -1 : segment;
-  };
-  for (std::size_t i = 0; i < albedo_due_.size(); ++i)
-    if (const int segment = segment_of(i); segment > 0) ++segment_starts_[std::size_t(segment)];
+  for (const int segment : due_segment_)
+    if (segment > 0) ++segment_starts_[std::size_t(segment)];
   std::exclusive_scan(segment_starts_.begin(), segment_starts_.end(), segment_starts_.begin(), 0);
   by_segment_.resize(std::size_t(segment_starts_.back()));
   segment_fill_.assign(segment_starts_.begin(), segment_starts_.end() - 1);
-  for (std::size_t i = 0; i < albedo_due_.size(); ++i)
-    if (const int segment = segment_of(i); segment > 0)
+  for (std::size_t i = 0; i < due_segment_.size(); ++i)
+    if (const int segment = due_segment_[i]; segment > 0)
       by_segment_[std::size_t(segment_fill_[std::size_t(segment)]++)] = due_albedo_[i];
-  albedo_reference_.resize(std::size_t(segments), NAN);
   for (int segment = 1; segment < segments; ++segment) {
     const auto first = by_segment_.begin() + segment_starts_[std::size_t(segment)];
     const auto last = by_segment_.begin() + segment_starts_[std::size_t(segment) + 1];
-    float& reference = albedo_reference_[std::size_t(segment)];
-    if (last - first >= kMinReferenceVoxels) {
-      std::nth_element(first, first + (last - first) / 2, last);
-      reference = *(first + (last - first) / 2);
-    } else if (std::isnan(reference)) {
-      if (const SegmentMaterial* material = specular_.material(segment))
-        reference = material->ward.kd.maxCoeff();
-    }
+    if (last - first < kMinReferenceVoxels) continue;  // the last one stays
+    std::nth_element(first, first + (last - first) / 2, last);
+    albedo_reference_[std::size_t(segment)] = *(first + (last - first) / 2);
   }
 }
 

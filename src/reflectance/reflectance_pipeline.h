@@ -152,18 +152,18 @@ class ReflectancePipeline {
   LightTransport transport_;
   std::vector<render::PointLight> lights_;
   StageTimings timings_;
-  // Each segment's reference albedo for the test of explained_by_light(), as its largest
-  // channel: the median over a frame's due voxels of their albedos solved under trusted light,
-  // where the segment has at least kMinReferenceVoxels of them; else its last one; before any,
-  // its HemiCNN albedo's. A median, since the voxels in shadows the geometry cannot cast are a
-  // minority of a segment, and the network's albedo can be off by more than the ratio (a dark
-  // object read as grey).
+  // Updates each segment's reference albedo for the test of explained_by_light() in the next
+  // frame, as its largest channel: the median over this frame's due voxels of their albedos
+  // solved under trusted light, where the segment has at least kMinReferenceVoxels of them;
+  // else it keeps its last one (before any, the test takes the segment's HemiCNN albedo). A
+  // median, since the voxels in shadows the geometry cannot cast are a minority of a segment,
+  // and the network's albedo can be off by more than the ratio (a dark object read as grey).
   void update_albedo_references(int segments);
   static constexpr int kMinReferenceVoxels = 16;
 
-  // Scratch of refine_albedo_of_visible(): the due voxels, their trusted albedos (NaN: none),
-  // and the counting sort of those by segment.
-  std::vector<int> albedo_due_;
+  // Scratch of refine_albedo_of_visible(): the due voxels, their trusted albedos and segments
+  // (-1: none), and the counting sort of those by segment.
+  std::vector<int> albedo_due_, due_segment_;
   std::vector<float> due_albedo_, by_segment_;
   std::vector<int> segment_starts_, segment_fill_;
   std::vector<float> albedo_reference_;  // per segment id; NaN: none yet
