@@ -35,10 +35,10 @@ namespace glint::reflectance {
 
 struct LightTransportParams {
   // Both off by default, by the rule docs/decisions.md states: on bunnies rendered with shadows
-  // (60 frames) shadows raise the refined-kd PSNR over the objects from 15.8 to 21.1 dB, but on
-  // the shadowless rendering they lower it from 27.6 to 17.9 dB (there light reaches what the
-  // geometry hides); the gather gains 0.8-2.1 dB where the input has bounced light and loses
-  // 2.9-5.1 dB where it has none (bunnies, office; docs/benchmarks.md).
+  // (100 frames) shadows raise the refined-kd PSNR over the objects from 21.2 to 27.5 dB, but on
+  // the shadowless rendering they lower it from 29.8 to 18.1 dB (there light reaches what the
+  // geometry hides); the gather gains 2.0 dB where the input has bounced light and loses
+  // 2.6-3.8 dB where it has none (bunnies, office; docs/benchmarks.md).
   bool shadows = false;
   bool indirect = false;
   // 2 TSDF voxels at the default 5 mm: the fused surface of a flat face scatters by about one
