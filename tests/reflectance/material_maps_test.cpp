@@ -355,18 +355,15 @@ TEST(MaterialMaps, AShadowTheGeometryCannotCastDimsTheDirectLightWhereItWasObser
   ASSERT_TRUE(lookup(edge, material));
   EXPECT_NEAR(material.direct_share, 1 - 0.75f / 2, 1e-5f);
 
-  render::WardMaterial m;
-  m.kd = {0.4f, 0.4f, 0.4f};
-  m.ks = {0.1f, 0.1f, 0.1f};
-  m.alpha = 0.2f;
   std::vector<render::PointLight> lights(1);
   lights[0].position = {0.3f, 0.2f, 0};
   lights[0].intensity = {2, 2, 2};
   const Eigen::Vector3f n(0, 0, -1), eye(0, 0, 0);
+  const float alpha = 0.2f;
   PointLighting lighting{.indirect = Eigen::Vector3f(0.1f, 0.2f, 0.3f)};
-  const WardShading whole = ward_shading(m.alpha, p, n, eye, lights, lighting);
+  const WardShading whole = ward_shading(alpha, p, n, eye, lights, lighting);
   lighting.direct_share = 0.25f;
-  const WardShading dimmed = ward_shading(m.alpha, p, n, eye, lights, lighting);
+  const WardShading dimmed = ward_shading(alpha, p, n, eye, lights, lighting);
   EXPECT_TRUE((dimmed.diffuse - lighting.indirect)
                   .isApprox(0.25f * (whole.diffuse - lighting.indirect), 1e-6f));
   EXPECT_TRUE(dimmed.specular.isApprox(0.25f * whole.specular, 1e-6f));
