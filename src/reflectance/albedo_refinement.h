@@ -60,9 +60,9 @@ inline float tangent_of(float cosine) { return std::sqrt(1 - cosine * cosine) / 
 
 // Whether a voxel's refined albedo is within a factor max_ratio (>= 1) of its segment's
 // reference albedo, both as their largest channel (a shadow dims every channel; a red patch on a
-// grey segment keeps one bright): beyond it the light model does not explain
-// the voxel's observations (ReflectanceParams::albedo_max_ratio). max_ratio 0, or no reference
-// (NaN), accepts every albedo.
+// grey segment keeps one bright): beyond it the light model does not explain the voxel's
+// observations (ReflectanceParams::albedo_max_ratio). max_ratio 0, or no reference (NaN),
+// accepts every albedo.
 inline bool explained_by_light(float refined, float reference, float max_ratio) {
   if (max_ratio == 0 || std::isnan(reference)) return true;
   return refined * max_ratio >= reference && refined <= reference * max_ratio;

@@ -34,11 +34,9 @@
 namespace glint::reflectance {
 
 struct LightTransportParams {
-  // Both off by default, by the rule docs/decisions.md states: on bunnies rendered with shadows
-  // (100 frames) shadows raise the refined-kd PSNR over the objects from 21.2 to 27.5 dB, but on
-  // the shadowless rendering they lower it from 29.8 to 18.1 dB (there light reaches what the
-  // geometry hides); the gather gains 2.0 dB where the input has bounced light and loses
-  // 2.6-3.8 dB where it has none (bunnies, office; docs/benchmarks.md).
+  // Both off by default, by the rule docs/decisions.md states: shadows lower the refined albedo
+  // where the input has none (light reaches what the geometry hides), and the gather where the
+  // input has no bounced light (figures: docs/benchmarks.md).
   bool shadows = false;
   bool indirect = false;
   // 2 TSDF voxels at the default 5 mm: the fused surface of a flat face scatters by about one

@@ -71,15 +71,15 @@ struct ReflectanceParams {
   // reference albedo (update_albedo_references()), or over this times it, is unreliable too: the
   // image model does not explain its observations. The usual cause is a shadow the fused geometry
   // cannot cast, because the occluder's far side was never in view, so the shadow ray passes
-  // through it and eq. (7) divides a black pixel by a light that never reached it. 3 was set before
-  // measuring: a shadow leaves the indirect light, well under a third of the direct, and few
-  // textures reach a third of their mean. 0 trusts such voxels, as the paper.
+  // through it and eq. (7) divides a black pixel by a light that never reached it. 3: a shadow
+  // leaves the indirect light, well under a third of the direct, and few textures reach a third
+  // of their mean. 0 trusts such voxels, as the paper.
   float albedo_max_ratio = 3.0f;
   // A voxel whose irradiance is more than this share gathered indirect light is unreliable too:
   // the gather is an estimate (emitters taken as diffuse, surfaces never seen as dark, 64 rays
   // of Monte Carlo noise), and where it is most of what eq. (7) divides by, its error is most of
   // the albedo's. Such voxels, mostly in shadow, take the albedo of their lit neighbours or
-  // segment instead. 0.5 was set before measuring; 1 trusts them all.
+  // segment instead. 1 trusts them all.
   float albedo_max_indirect_share = 0.5f;
   // Re-renderings and the mesh smooth the refined albedo between neighbouring voxels that agree
   // to about this relative contrast (interpolate_refined_kd in reflectance/material_maps.h);

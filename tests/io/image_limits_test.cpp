@@ -103,7 +103,7 @@ TEST(ImageLimits, EveryPartOfAMultiPartExrIsChecked) {
 }
 
 // OpenCV would pass these to GDAL, which tries all of its drivers and prints on stderr, and to
-// GDCM, which aborts on some malformed DICOM files (an assertion; found by the image fuzz target,
+// GDCM, which aborts on some malformed DICOM files (an assertion; such a file is
 // fuzz/corpus/image/regression-dicom-gdcm-assertion).
 TEST(ImageLimits, GisAndMedicalFormatsAreRefusedWithOneLine) {
   const std::string nitf = scratch("map.ntf");
