@@ -149,7 +149,9 @@ std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int 
   int used = 0;
   // Clipped observations only where every one is: a clipped channel bounds the radiance from
   // below, so its eq. (7) albedo is too dark (by the clipped highlight's part, too).
+  bool only_clipped = false;
   for (const bool take_clipped : {false, true}) {
+    only_clipped = take_clipped;
     for (int k = 0; k < std::min(count, kMaxObservationsPerVoxel); ++k) {
       const Eigen::Vector3f direction = observations[k].direction();
       if (!(normal.dot(direction) > 0.0f)) continue;
@@ -190,6 +192,7 @@ std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int 
   RefinedAlbedo refined;
   refined.light_tangent = sines / cosines;
   refined.indirect_share = lighting.indirect.mean() / cosines;
+  refined.lower_bound = only_clipped;
   std::array<Channels, std::max(kMaxObservationsPerVoxel, kNetworkSize)> values;
   for (int j = 0; j < used; ++j) {
     values[j] = Channels{};

@@ -44,6 +44,8 @@ struct RefinedAlbedo {
   float light_tangent = 0.0f;
   // The gathered indirect light's share of the irradiance eq. (7) divided by (by luminance).
   float indirect_share = 0.0f;
+  // Every observation had clipped: kd is a lower bound on the albedo, not an estimate of it.
+  bool lower_bound = false;
   float light_cosine() const { return 1.0f / std::sqrt(1.0f + light_tangent * light_tangent); }
 };
 
@@ -66,6 +68,25 @@ inline float tangent_of(float cosine) { return std::sqrt(1 - cosine * cosine) / 
 inline bool explained_by_light(float refined, float reference, float max_ratio) {
   if (max_ratio == 0 || std::isnan(reference)) return true;
   return refined * max_ratio >= reference && refined <= reference * max_ratio;
+}
+
+// What a voxel's refined albedo (its largest channel `refined`) is worth against its segment's
+// reference: an estimate (usable where its light can be trusted), or none, and then the share of
+// direct light it lacked, which re-renderings take away (0 where it lacked none).
+struct AlbedoVerdict {
+  bool estimate = true;
+  float light_shortfall = 0.0f;
+};
+// A lower bound (RefinedAlbedo::lower_bound) below the reference says less than the reference
+// does: no estimate, and no light lacking (it is dark for want of the sensor's range). Beyond
+// max_ratio (explained_by_light()) no estimate either; if it is too dark, the light is short by
+// 1 - refined / reference. max_ratio 0, or no reference (NaN), accepts every albedo.
+inline AlbedoVerdict judge_albedo(float refined, bool lower_bound, float reference,
+                                  float max_ratio) {
+  if (max_ratio == 0 || std::isnan(reference)) return {};
+  if (lower_bound && refined < reference) return {false, 0.0f};
+  if (explained_by_light(refined, reference, max_ratio)) return {};
+  return {false, std::max(0.0f, 1 - refined / reference)};
 }
 
 // Eq. (7) over the voxel's observations under `lighting` (the lights that reach it, its

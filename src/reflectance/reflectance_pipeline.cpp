@@ -134,10 +134,10 @@ void ReflectancePipeline::refine_albedo_of_visible() {
       const bool known = in_map && !std::isnan(albedo_reference_[std::size_t(segment)]);
       const float reference =
           known ? albedo_reference_[std::size_t(segment)] : material->ward.kd.maxCoeff();
-      if (!explained_by_light(kd.maxCoeff(), reference, params_.albedo_max_ratio)) {
-        grid_.light_shortfall(v) = std::max(0.0f, 1 - kd.maxCoeff() / reference);
-        continue;
-      }
+      const AlbedoVerdict verdict =
+          judge_albedo(kd.maxCoeff(), refined->lower_bound, reference, params_.albedo_max_ratio);
+      grid_.light_shortfall(v) = verdict.light_shortfall;
+      if (!verdict.estimate) continue;
       grid_.refined_kd_reliable(v) = trusted_light;
       if (trusted_light && in_map)
         segment_sums[segment] +=

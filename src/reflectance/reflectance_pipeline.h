@@ -152,7 +152,7 @@ class ReflectancePipeline {
   LightTransport transport_;
   std::vector<render::PointLight> lights_;
   StageTimings timings_;
-  // Updates each segment's reference albedo for the test of explained_by_light() in the next
+  // Updates each segment's reference albedo for the test of judge_albedo() in the next
   // frame, as its largest channel: the median over this frame's due voxels of their albedos
   // solved under trusted light, where the segment has at least kMinReferenceVoxels of them;
   // else it keeps its last one (before any, the test takes the segment's HemiCNN albedo). A

@@ -115,16 +115,22 @@ TEST(AlbedoRefinement, ClippedObservationsCountOnlyWhereAllClipped) {
   const auto clean = voxel.refine(obs, AlbedoAverage::mean, saturated);
   const auto dragged = voxel.refine(obs, AlbedoAverage::mean);
   ASSERT_TRUE(clean && dragged);
+  EXPECT_FALSE(clean->lower_bound);
+  EXPECT_FALSE(dragged->lower_bound);
   const Eigen::Vector3f& kd = voxel.material.kd;
   EXPECT_TRUE(clean->kd.isApprox(kd, 1e-3f)) << clean->kd.transpose();  // binary16 colours
   EXPECT_LT(dragged->kd.x(), kd.x() - 0.05f);
 
-  // Where every observation clipped, they are all there is: the same as taking them in.
+  // Where every observation clipped, they are all there is: the same as taking them in, and
+  // marked as a lower bound.
   const std::vector<Observation> only_clipped{obs.back()};
   const auto lower_bound = voxel.refine(only_clipped, AlbedoAverage::mean, saturated);
   const auto taken = voxel.refine(only_clipped, AlbedoAverage::mean);
   ASSERT_TRUE(lower_bound && taken);
   EXPECT_EQ(lower_bound->kd, taken->kd);
+  EXPECT_TRUE(lower_bound->lower_bound);
+  EXPECT_FALSE(taken->lower_bound);
+  EXPECT_LT(lower_bound->kd.x(), kd.x());
 }
 
 TEST(AlbedoRefinement, MedianIsThePerChannelMedianForEveryCount) {
@@ -220,6 +226,32 @@ TEST(AlbedoRefinement, AnAlbedoMoreThanTheRatioFromItsSegmentsIsNotExplainedByTh
   // Ratio 0, or no reference yet: everything, as the paper.
   EXPECT_TRUE(explained_by_light(0.0f, 0.4f, 0));
   EXPECT_TRUE(explained_by_light(0.0f, NAN, 3));
+}
+
+TEST(AlbedoRefinement, TooDarkAlbedosLackLightUnlessTheyAreLowerBounds) {
+  // Within the ratio: an estimate, lacking no light.
+  AlbedoVerdict verdict = judge_albedo(0.3f, false, 0.4f, 3);
+  EXPECT_TRUE(verdict.estimate);
+  EXPECT_EQ(verdict.light_shortfall, 0.0f);
+  // A voxel read as lit in a shadow: no estimate, and three quarters of its light missing.
+  verdict = judge_albedo(0.1f, false, 0.4f, 3);
+  EXPECT_FALSE(verdict.estimate);
+  EXPECT_FLOAT_EQ(verdict.light_shortfall, 0.75f);
+  // Too bright: no estimate, no light missing.
+  verdict = judge_albedo(0.9f, false, 0.2f, 3);
+  EXPECT_FALSE(verdict.estimate);
+  EXPECT_EQ(verdict.light_shortfall, 0.0f);
+  // Every observation clipped: a bound below the reference is no estimate, even within the
+  // ratio, and it lacks no light; one above the reference is kept.
+  for (const float bound : {0.1f, 0.3f}) {
+    verdict = judge_albedo(bound, true, 0.4f, 3);
+    EXPECT_FALSE(verdict.estimate) << bound;
+    EXPECT_EQ(verdict.light_shortfall, 0.0f) << bound;
+  }
+  EXPECT_TRUE(judge_albedo(0.5f, true, 0.4f, 3).estimate);
+  // No reference yet, or the test off: everything, as the paper.
+  EXPECT_TRUE(judge_albedo(0.0f, true, NAN, 3).estimate);
+  EXPECT_TRUE(judge_albedo(0.0f, true, 0.4f, 0).estimate);
 }
 
 TEST(AlbedoRefinement, UnlitOrUnseenVoxelsHaveNoEstimate) {
