@@ -33,6 +33,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 #include <random>
 
 #include "cad/sample.h"
@@ -73,6 +74,15 @@ class Deadline : public Message_ProgressIndicator {
  private:
   std::chrono::steady_clock::time_point end_;
 };
+
+// OpenCASCADE 7.6's modelling algorithms are not reentrant: the fillet builder keeps a file-scope
+// static mode flag (TopOpeBRepBuild's STATIC_SOLIDINDEX; OCCT pull request #1374), so two
+// threads modelling independent parts corrupt each other's solids or crash. Modelling holds this
+// process-wide lock; tessellation and sampling of the finished parts run in parallel.
+std::recursive_mutex& modelling_mutex() {
+  static std::recursive_mutex mutex;
+  return mutex;
+}
 
 struct Box {
   double x0, y0, z0, x1, y1, z1;
@@ -462,6 +472,7 @@ void check_part_params(const PartParams& p) {
 }
 
 TopoDS_Shape cut_open(const TopoDS_Shape& shape, const double point[3], const double normal[3]) {
+  const std::lock_guard lock(modelling_mutex());
   try {
     const gp_Dir n(normal[0], normal[1], normal[2]);
     const Box b = bounding_box(shape);
@@ -496,6 +507,7 @@ TopoDS_Shape cut_open(const TopoDS_Shape& shape, const double point[3], const do
 
 Part random_part(const PartParams& params, std::uint64_t index) {
   check_part_params(params);
+  const std::lock_guard lock(modelling_mutex());
   Rng rng(splitmix64(params.seed ^ splitmix64(index)));
   const auto& names = part_recipe_names();
   const PartRecipe recipe =

@@ -9,7 +9,8 @@
 // Every kernel operation that fails (Standard_Failure, not done, an invalid result, or past
 // its time limit) is skipped and recorded, so a part is always produced; the recipe JSON says
 // what was built. Same (params, index) -> same part on every run and thread count, unless an
-// operation hit the time limit (recorded as "timed_out" in the recipe).
+// operation hit the time limit (recorded as "timed_out" in the recipe). Thread-safe: the
+// kernel's modelling algorithms are not reentrant, so random_part and cut_open take turns.
 #include <TopoDS_Shape.hxx>
 #include <cstdint>
 #include <nlohmann/json.hpp>
