@@ -29,8 +29,10 @@ def row(report):
 
 def wide_angle_gap(report):
     """The angle-gap MCC at 4 spacings, k 64, from the sibling report of a boundary set."""
+    if "-boundary-3c" not in report.name:
+        return {}
     wide = report.with_name(report.name.replace("-boundary-3c", "-boundary-angle-gap-4"))
-    if "-boundary-3c" not in report.name or not wide.exists():
+    if not wide.exists():
         return {}
     mcc = json.loads(wide.read_text())["summary"]["angle-gap"]["median"]["mcc"]
     return {"angle-gap 4 spacings, k 64": f"{mcc:.3f}"}
