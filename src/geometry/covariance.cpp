@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -16,34 +17,124 @@ SymmetricMatrix3 Moments::covariance() const {
 
 namespace {
 
-// Eigenvalues in descending order, unclamped (Smith 1961: A = qI + pB, eig(B) = 2cos(φ + 2πj/3)).
-Eigen::Vector3d raw_eigenvalues(const SymmetricMatrix3& m) {
-  const double off = m.xy * m.xy + m.xz * m.xz + m.yz * m.yz;
-  const double q = (m.xx + m.yy + m.zz) / 3.0;
-  const double dxx = m.xx - q, dyy = m.yy - q, dzz = m.zz - q;
-  const double p2 = dxx * dxx + dyy * dyy + dzz * dzz + 2.0 * off;
-  if (p2 <= 0.0) return {q, q, q};
-  const double p = std::sqrt(p2 / 6.0);
-  // det(B) / 2 with B = (A - qI) / p.
-  const double det = dxx * (dyy * dzz - m.yz * m.yz) - m.xy * (m.xy * dzz - m.yz * m.xz) +
-                     m.xz * (m.xy * m.yz - dyy * m.xz);
-  const double r = std::clamp(det / (2.0 * p * p * p), -1.0, 1.0);
-  const double phi = std::acos(r) / 3.0;
-  // cos(φ + 2π/3) = -cos(φ)/2 - sin(φ)·√3/2: one sin/cos pair instead of two cosines.
-  const double cos_phi = std::cos(phi), sin_phi = std::sin(phi);
-  const double largest = q + 2.0 * p * cos_phi;
-  const double smallest = q + p * (-cos_phi - std::numbers::sqrt3 * sin_phi);
-  return {largest, 3.0 * q - largest - smallest, smallest};
+// Taylor coefficients, computed at compile time: asin x = x·Σ a_n x^2n (a_n = (2n)!/(4^n (n!)²
+// (2n+1))), and the even and odd series of cos and sin.
+template <int Terms>
+constexpr std::array<double, Terms> asin_series() {
+  std::array<double, Terms> a{};
+  double central = 1.0;  // (2n)!/(4^n (n!)²)
+  for (int n = 0; n < Terms; ++n) {
+    a[n] = central / (2 * n + 1);
+    central *= double(2 * n + 1) / double(2 * n + 2);
+  }
+  return a;
+}
+template <int Terms>
+constexpr std::array<double, Terms> trig_series(int first_power) {
+  std::array<double, Terms> a{};
+  double term = 1.0;
+  for (int power = 1; power <= first_power; ++power) term /= power;
+  for (int n = 0; n < Terms; ++n) {
+    a[n] = term;
+    term *= -1.0 / ((first_power + 2 * n + 1) * (first_power + 2 * n + 2));
+  }
+  return a;
+}
+// |x| <= 1/2: the first omitted asin term is below 3e-17; phi <= pi/3: the cos and sin
+// series stop below 1e-17.
+constexpr auto kAsin = asin_series<24>();
+constexpr auto kCos = trig_series<11>(0);
+constexpr auto kSin = trig_series<10>(1);
+
+template <std::size_t Terms>
+inline double horner(const std::array<double, Terms>& a, double z) {
+  double sum = a[Terms - 1];
+#pragma GCC unroll 32
+  for (int n = int(Terms) - 2; n >= 0; --n) sum = sum * z + a[n];
+  return sum;
+}
+
+// acos through asin of an argument of at most 1/2 (the half-angle form beyond |r| = 1/2), so
+// one polynomial serves all r, branch-free: the loops below vectorise across matrices.
+inline double acos_polynomial(double r) {
+  const double magnitude = std::abs(r);
+  const bool central = magnitude <= 0.5;
+  const double half_angle = std::sqrt((1.0 - magnitude) * 0.5);
+  const double x = central ? r : half_angle;
+  const double asin_x = x * horner(kAsin, x * x);
+  const double outer = r > 0 ? 2.0 * asin_x : std::numbers::pi - 2.0 * asin_x;
+  return central ? std::numbers::pi / 2 - asin_x : outer;
+}
+
+// Eigenvalues of `Lanes` matrices given entry by entry, descending and clamped at zero
+// (Smith 1961: A = qI + pB, eig(B) = 2cos(φ + 2πj/3)). One code path for one matrix and for
+// a batch, so both give the same values up to rounding.
+template <int Lanes>
+inline void eigenvalues_lanes(const double* xx, const double* xy, const double* xz,
+                              const double* yy, const double* yz, const double* zz, double* largest,
+                              double* middle, double* smallest) {
+  for (int i = 0; i < Lanes; ++i) {
+    const double off = xy[i] * xy[i] + xz[i] * xz[i] + yz[i] * yz[i];
+    const double q = (xx[i] + yy[i] + zz[i]) / 3.0;
+    const double dxx = xx[i] - q, dyy = yy[i] - q, dzz = zz[i] - q;
+    const double p2 = dxx * dxx + dyy * dyy + dzz * dzz + 2.0 * off;
+    const bool isotropic = !(p2 > 0.0);
+    const double p = std::sqrt(isotropic ? 1.0 : p2 / 6.0);
+    // det(B) / 2 with B = (A - qI) / p.
+    const double det = dxx * (dyy * dzz - yz[i] * yz[i]) - xy[i] * (xy[i] * dzz - yz[i] * xz[i]) +
+                       xz[i] * (xy[i] * yz[i] - dyy * xz[i]);
+    const double r = std::min(1.0, std::max(-1.0, det / (2.0 * p * p * p)));
+    // One matrix: libm (a flat patch's zero eigenvalue stays exactly zero, as the denoisers'
+    // noise maps expect); a batch: the polynomials, which vectorise.
+    double cos_phi, sin_phi;
+    if constexpr (Lanes == 1) {
+      const double phi = std::acos(r) / 3.0;
+      cos_phi = std::cos(phi), sin_phi = std::sin(phi);
+    } else {
+      const double phi = acos_polynomial(r) / 3.0, phi2 = phi * phi;
+      cos_phi = horner(kCos, phi2), sin_phi = phi * horner(kSin, phi2);
+    }
+    // cos(φ + 2π/3) = -cos(φ)/2 - sin(φ)·√3/2.
+    const double first = isotropic ? q : q + 2.0 * p * cos_phi;
+    const double last = isotropic ? q : q + p * (-cos_phi - std::numbers::sqrt3 * sin_phi);
+    largest[i] = std::max(0.0, first);
+    middle[i] = std::max(0.0, 3.0 * q - first - last);
+    smallest[i] = std::max(0.0, last);
+  }
 }
 
 }  // namespace
 
 Eigen::Vector3d eigenvalues_descending(const SymmetricMatrix3& m) {
-  return raw_eigenvalues(m).cwiseMax(0.0);
+  Eigen::Vector3d out;
+  eigenvalues_lanes<1>(&m.xx, &m.xy, &m.xz, &m.yy, &m.yz, &m.zz, &out[0], &out[1], &out[2]);
+  return out;
+}
+
+#if defined(__x86_64__)
+__attribute__((target_clones("arch=x86-64-v3", "default"), flatten))
+#endif
+void eigenvalues_descending(const SymmetricMatrix3* m, int count, Eigen::Vector3d* out) {
+  constexpr int lanes = 8;
+  for (int first = 0; first < count; first += lanes) {
+    // Entry by entry (structure of arrays); unused lanes hold zero matrices.
+    double xx[lanes] = {}, xy[lanes] = {}, xz[lanes] = {}, yy[lanes] = {}, yz[lanes] = {},
+           zz[lanes] = {}, largest[lanes], middle[lanes], smallest[lanes];
+    const int used = std::min(lanes, count - first);
+    for (int i = 0; i < used; ++i) {
+      const SymmetricMatrix3& a = m[first + i];
+      xx[i] = a.xx, xy[i] = a.xy, xz[i] = a.xz, yy[i] = a.yy, yz[i] = a.yz, zz[i] = a.zz;
+    }
+    eigenvalues_lanes<lanes>(xx, xy, xz, yy, yz, zz, largest, middle, smallest);
+    for (int i = 0; i < used; ++i) out[first + i] = {largest[i], middle[i], smallest[i]};
+  }
 }
 
 Eigen::Vector3d smallest_eigenvector(const SymmetricMatrix3& m) {
-  const double lambda = raw_eigenvalues(m)[2];
+  return smallest_eigenvector(m, eigenvalues_descending(m)[2]);
+}
+
+Eigen::Vector3d smallest_eigenvector(const SymmetricMatrix3& m, double lambda) {
   // Rows of A - λI span the plane orthogonal to the eigenvector: the largest cross product of
   // two rows is the most accurate direction.
   const Eigen::Vector3d r0(m.xx - lambda, m.xy, m.xz);

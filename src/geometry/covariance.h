@@ -1,6 +1,6 @@
 #pragma once
 // Moments of small point sets and closed-form eigen-analysis of their 3×3 covariance.
-// Written for inner loops: no allocation, no iteration, a few libm calls.
+// Written for inner loops: no allocation, no iteration; batches call no libm function.
 #include <Eigen/Core>
 #include <array>
 
@@ -52,8 +52,15 @@ class Moments {
 // the largest eigenvalue, less than float features resolve.
 Eigen::Vector3d eigenvalues_descending(const SymmetricMatrix3& m);
 
+// The same for `count` matrices at once, written to out[0, count): vectorised across
+// matrices (eight at a time), with acos, cos and sin as polynomials; equal to the
+// single-matrix values up to rounding.
+void eigenvalues_descending(const SymmetricMatrix3* m, int count, Eigen::Vector3d* out);
+
 // Unit eigenvector of the smallest eigenvalue (the normal of a fitted plane); any unit vector
 // when the matrix is a multiple of the identity. Sign is arbitrary.
 Eigen::Vector3d smallest_eigenvector(const SymmetricMatrix3& m);
+// The same when the smallest eigenvalue is already known (e.g. from a batch).
+Eigen::Vector3d smallest_eigenvector(const SymmetricMatrix3& m, double smallest_eigenvalue);
 
 }  // namespace glint::geometry

@@ -4,6 +4,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <random>
+#include <vector>
 
 namespace glint::geometry {
 namespace {
@@ -55,6 +56,49 @@ TEST(Covariance, MomentsOfSubsetsSubtract) {
   EXPECT_DOUBLE_EQ(c.zz, 4.0);
   EXPECT_DOUBLE_EQ(c.xz, 1.0);
   EXPECT_DOUBLE_EQ(c.yy, 0.0);
+}
+
+TEST(Covariance, BatchMatchesSingleMatricesAcrossLaneChunks) {
+  // 13 matrices: one full chunk of eight lanes and a partial one; eigenvalue patterns that put
+  // the cubic's acos argument at -1 (a plane: two equal largest), +1 (a line: two equal
+  // smallest), 0 and in between.
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g(0, 1);
+  const Eigen::Vector3d patterns[] = {{1, 1, 0},       {1, 0, 0}, {1, 0.5, 0},     {2, 1, 0.5},
+                                      {1, 1e-3, 1e-9}, {3, 3, 3}, {1, 0.999, 1e-4}};
+  std::vector<SymmetricMatrix3> matrices;
+  std::vector<Eigen::Vector3d> expected;
+  for (int i = 0; i < 13; ++i) {
+    const Eigen::Matrix3d q =
+        Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
+    const Eigen::Vector3d values = patterns[i % 7] * std::pow(10.0, i % 5 - 2);
+    matrices.push_back(from_eigen(q * values.asDiagonal() * q.transpose()));
+    expected.push_back(values);
+  }
+  std::vector<Eigen::Vector3d> batch(matrices.size());
+  eigenvalues_descending(matrices.data(), int(matrices.size()), batch.data());
+  for (std::size_t i = 0; i < matrices.size(); ++i) {
+    const double largest = expected[i][0];
+    const Eigen::Vector3d single = eigenvalues_descending(matrices[i]);
+    for (int j = 0; j < 3; ++j) {
+      EXPECT_NEAR(batch[i][j], expected[i][j], 1e-7 * largest) << "matrix " << i << ", " << j;
+      // Equal eigenvalues make the trigonometric form sensitive to rounding (~1e-8, see above),
+      // and the batch may round differently (fused multiply-adds in its vector clone).
+      EXPECT_NEAR(batch[i][j], single[j], 1e-7 * largest) << "matrix " << i << ", " << j;
+    }
+  }
+}
+
+TEST(Covariance, BatchIsExactOnDiagonalMatrices) {
+  // Distinct eigenvalues and no rotation: the polynomial acos, cos and sin alone decide the
+  // error (equal eigenvalues cost the trigonometric form ~1e-8, as above).
+  const Eigen::Vector3d cases[] = {{4, 2, 1}, {3, 2, 0}, {1, 0.25, 0.0625}, {10, 9, 0.5}};
+  for (const Eigen::Vector3d& values : cases) {
+    const SymmetricMatrix3 m{values[2], 0, 0, values[0], 0, values[1]};
+    Eigen::Vector3d closed;
+    eigenvalues_descending(&m, 1, &closed);
+    EXPECT_NEAR((closed - values).norm(), 0.0, 1e-13 * values[0]) << values.transpose();
+  }
 }
 
 }  // namespace
