@@ -13,7 +13,9 @@ struct Classification {
   std::vector<std::uint8_t> labels;  // 0 non-edge, 1 sharp edge, 2 boundary
   std::vector<float> p_sharp;        // softmax probability of the sharp class
   std::vector<float> p_boundary;     // of the boundary class (0 for a 2-class model)
-  double features_s = 0;             // wall-clock seconds spent in each stage
+  // Wall-clock seconds of each stage; classify() runs them interleaved and splits its time
+  // between them in proportion to the thread time each took.
+  double features_s = 0;
   double inference_s = 0;
 };
 

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/cpu_level.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/progress.h"
@@ -48,12 +49,26 @@ Moments sum_moments(const geometry::Neighbourhood& nb, int begin, int end, Weigh
   return Moments({n, sx, sy, sz, sxx, sxy, sxz, syy, syz, szz});
 }
 
+// One scale of one point: its k nearest neighbours' moments and what later steps need.
+struct ScaleState {
+  int k = 0;
+  Moments all, upper, lower;
+  Vector3d centre = Vector3d::Zero();
+  Vector3d normal = Vector3d::UnitZ();
+  double spread = 0;  // sqrt(σ1) + sqrt(σ2), eq. (5.4)
+};
+
 struct Scratch {
   static constexpr int kBuckets = 64;
   std::vector<float> squared_distances;
   std::vector<std::uint8_t> bucket_of;
   std::vector<std::uint64_t> straddling;
-  std::vector<Moments> scale_moments;
+  // Rows handed out in blocks (compute_features_in_blocks): the block's points and rows.
+  std::vector<std::uint32_t> block_points;
+  std::vector<float> block_rows;
+  std::vector<ScaleState> states;
+  std::vector<geometry::SymmetricMatrix3> matrices;
+  std::vector<Vector3d> eigenvalues;
 };
 
 // Moments of the `count` neighbours closest to `centre` (§5.4.1: the normal is fitted to the
@@ -101,81 +116,120 @@ Moments moments_nearest_to(const geometry::Neighbourhood& nb, int k, const Vecto
   return nearest;
 }
 
-// The largest scale's centre and normal, needed by every smaller scale for eq. (5.17).
-struct LargestScale {
-  int k = 0;
-  Vector3d centre = Vector3d::Zero();
-  Vector3d normal = Vector3d::UnitZ();
-};
-
-// Features of one scale from its k nearest neighbours (positions relative to the query point,
-// which is therefore the origin) and their precomputed moments.
-void scale_features(const geometry::Neighbourhood& nb, int k, const Moments& moments,
-                    LargestScale& largest, Scratch& scratch, float* out) {
+// The twelve features of one scale, eqs. (5.9)-(5.18); `upper_sigma` and `lower_sigma` are the
+// subsets' covariance eigenvalues. Positions are relative to the query point (the origin).
+void scale_features(const ScaleState& state, const ScaleState& largest, const Vector3d& upper_sigma,
+                    const Vector3d& lower_sigma, float* out) {
   std::fill(out, out + kFeaturesPerScale, 0.0f);
-  const Vector3d centre = moments.mean();                                         // eq. (5.3)
-  const Vector3d sigma = geometry::eigenvalues_descending(moments.covariance());  // eq. (5.2)
-
-  const Moments core = moments_nearest_to(nb, k, centre, std::max(3, k / 2), scratch);
-  Vector3d normal = geometry::smallest_eigenvector(core.covariance());
-  // Orientation (our choice): the query point lies in the upper half-space, s_perp >= 0.
-  if ((-centre).dot(normal) < 0) normal = -normal;
-
-  const bool is_largest = largest.k == 0;
-  if (is_largest) largest = {k, centre, normal};
-
-  const double spread = std::sqrt(sigma[0]) + std::sqrt(sigma[1]);
-  if (!(spread > 0) || !std::isfinite(spread)) return;  // all neighbours coincide
-  const double scale = 2.0 / spread;                    // eq. (5.4)
-
-  // Upper / lower split, eqs. (5.5)-(5.6): <p - centre, n> >= 0. Only the upper moments are
-  // summed (branch-free weight); lower = all - upper. Moments are gathered in the query frame
-  // and normalised afterwards (mean: (m - centre)·scale, covariance: ·scale²).
-  const float nx = float(normal.x()), ny = float(normal.y()), nz = float(normal.z());
-  const float plane = float(centre.dot(normal));
-  const Moments upper = sum_moments(nb, 0, k, [&](int j) {
-    return nb.dx[j] * nx + nb.dy[j] * ny + nb.dz[j] * nz >= plane ? 1.f : 0.f;
-  });
-  const Moments lower = moments.minus(upper);
+  if (!(state.spread > 0) || !std::isfinite(state.spread)) return;  // all neighbours coincide
+  const double scale = 2.0 / state.spread;                          // eq. (5.4)
+  // Moments were gathered in the query frame and are normalised here (mean: (m - centre)·scale,
+  // covariance: ·scale²).
   const double scale2 = scale * scale;
-  if (upper.count() > 0) {
-    const Vector3d s = geometry::eigenvalues_descending(upper.covariance()) * scale2;
-    for (int i = 0; i < 3; ++i) out[i] = float(s[i]);
+  const bool has_upper = state.upper.count() > 0, has_lower = state.lower.count() > 0;
+  for (int i = 0; i < 3; ++i) {
+    if (has_upper) out[i] = float(upper_sigma[i] * scale2);  // eq. (5.13)
+    if (has_lower) out[3 + i] = float(lower_sigma[i] * scale2);
   }
-  if (lower.count() > 0) {
-    const Vector3d s = geometry::eigenvalues_descending(lower.covariance()) * scale2;
-    for (int i = 0; i < 3; ++i) out[3 + i] = float(s[i]);
+  const Vector3d& normal = state.normal;
+  if (has_upper && has_lower) {
+    split_along((state.upper.mean() - state.lower.mean()) * scale, normal, out[6],
+                out[7]);  // eqs. (5.9)-(5.10)
   }
-  if (upper.count() > 0 && lower.count() > 0) {
-    split_along((upper.mean() - lower.mean()) * scale, normal, out[6], out[7]);  // (5.9)-(5.10)
-  }
-  split_along(-centre * scale, normal, out[8], out[9]);  // eqs. (5.11)-(5.12)
+  split_along(-state.centre * scale, normal, out[8], out[9]);  // eqs. (5.11)-(5.12)
 
-  if (!is_largest && largest.k > k) {
+  if (largest.k > state.k) {
     // Centre of the largest scale's points that are not in this scale, eqs. (5.17)-(5.18).
-    const Vector3d rest = (largest.centre * largest.k - centre * k) / double(largest.k - k);
-    split_along((centre - rest) * scale, largest.normal, out[10], out[11]);
+    const Vector3d rest =
+        (largest.centre * largest.k - state.centre * state.k) / double(largest.k - state.k);
+    split_along((state.centre - rest) * scale, largest.normal, out[10], out[11]);
   }
 }
 
 // All scales of one point. The neighbour list is ordered nearest first, so the moments of
-// every scale come from one pass with prefix sums.
+// every scale come from one pass with prefix sums; the eigen solves of all scales run as two
+// batches (vectorised across matrices).
 void point_features(const geometry::Neighbourhood& nb, const std::vector<int>& scales,
                     Scratch& scratch, float* row) {
   const int count = static_cast<int>(scales.size());
-  scratch.scale_moments.resize(count);
+  std::vector<ScaleState>& states = scratch.states;
+  std::vector<geometry::SymmetricMatrix3>& matrices = scratch.matrices;
+  std::vector<Vector3d>& eigenvalues = scratch.eigenvalues;
+  states.resize(count);
+  matrices.resize(2 * count);
+  eigenvalues.resize(2 * count);
   Moments prefix;
   int added = 0;
   for (int s = count - 1; s >= 0; --s) {
     prefix = prefix.plus(sum_moments(nb, added, scales[s], [](int) { return 1.f; }));
     added = scales[s];
-    scratch.scale_moments[s] = prefix;
+    states[s].k = scales[s];
+    states[s].all = prefix;
   }
-  LargestScale largest;
+
+  // Batch 1: each scale's covariance (eq. 5.2) and that of the floor(k/2) neighbours nearest
+  // its centre (eq. 5.3), whose smallest eigenvector is the normal (§5.4.1).
   for (int s = 0; s < count; ++s) {
-    scale_features(nb, scales[s], scratch.scale_moments[s], largest, scratch,
+    ScaleState& state = states[s];
+    state.centre = state.all.mean();
+    matrices[s] = state.all.covariance();
+    matrices[count + s] =
+        moments_nearest_to(nb, state.k, state.centre, std::max(3, state.k / 2), scratch)
+            .covariance();
+  }
+  geometry::eigenvalues_descending(matrices.data(), 2 * count, eigenvalues.data());
+
+  // Batch 2: the upper and lower subsets, eqs. (5.5)-(5.6): <p - centre, n> >= 0. Only the
+  // upper moments are summed (branch-free weight); lower = all - upper.
+  for (int s = 0; s < count; ++s) {
+    ScaleState& state = states[s];
+    state.spread = std::sqrt(eigenvalues[s][0]) + std::sqrt(eigenvalues[s][1]);
+    Vector3d normal =
+        geometry::smallest_eigenvector(matrices[count + s], eigenvalues[count + s][2]);
+    // Orientation (our choice): the query point lies in the upper half-space, s_perp >= 0.
+    if ((-state.centre).dot(normal) < 0) normal = -normal;
+    state.normal = normal;
+    const float nx = float(normal.x()), ny = float(normal.y()), nz = float(normal.z());
+    const float plane = float(state.centre.dot(normal));
+    state.upper = sum_moments(nb, 0, state.k, [&](int j) {
+      return nb.dx[j] * nx + nb.dy[j] * ny + nb.dz[j] * nz >= plane ? 1.f : 0.f;
+    });
+    state.lower = state.all.minus(state.upper);
+    matrices[s] = state.upper.count() > 0 ? state.upper.covariance() : geometry::SymmetricMatrix3{};
+    matrices[count + s] =
+        state.lower.count() > 0 ? state.lower.covariance() : geometry::SymmetricMatrix3{};
+  }
+  geometry::eigenvalues_descending(matrices.data(), 2 * count, eigenvalues.data());
+
+  for (int s = 0; s < count; ++s) {
+    scale_features(states[s], states[0], eigenvalues[s], eigenvalues[count + s],
                    row + s * kFeaturesPerScale);
   }
+}
+
+using PointKernel = void (*)(const geometry::Neighbourhood&, const std::vector<int>&, Scratch&,
+                             float*);
+
+[[gnu::flatten]] void point_features_baseline(const geometry::Neighbourhood& nb,
+                                              const std::vector<int>& scales, Scratch& scratch,
+                                              float* row) {
+  point_features(nb, scales, scratch, row);
+}
+#if defined(__x86_64__)
+// The same code in eight-lane vectors with fused multiply-adds: the moment sums round in
+// another order, so features differ from the baseline's by float rounding.
+[[gnu::target("arch=x86-64-v3"), gnu::flatten]] void point_features_x86_64_v3(
+    const geometry::Neighbourhood& nb, const std::vector<int>& scales, Scratch& scratch,
+    float* row) {
+  point_features(nb, scales, scratch, row);
+}
+#endif
+
+PointKernel point_kernel() {
+#if defined(__x86_64__)
+  if (cpu_has_x86_64_v3()) return point_features_x86_64_v3;
+#endif
+  return point_features_baseline;
 }
 
 }  // namespace
@@ -194,7 +248,9 @@ void check_scales(const std::vector<int>& scales) {
   }
 }
 
-FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& params) {
+namespace {
+
+void check_cloud(const PointCloud& cloud, const FeatureParams& params) {
   check_scales(params.scales);
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     if (!std::isfinite(cloud.x[i]) || !std::isfinite(cloud.y[i]) || !std::isfinite(cloud.z[i])) {
@@ -216,27 +272,71 @@ FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& par
                     " points; the largest scale needs at least " +
                     std::to_string(params.scales[0]));
   }
+}
 
-  FeatureMatrix features;
-  features.points = cloud.size();
-  features.scales = static_cast<int>(params.scales.size());
-  features.values.resize(features.points * features.row_size());
-
-  tbb::enumerable_thread_specific<Scratch> scratches;
+// Every point's features, written to row_for(point, scratch); row_written(point, scratch)
+// follows on the same thread. The cloud must have passed check_cloud.
+template <class RowFor, class RowWritten>
+void compute_rows(const PointCloud& cloud, const FeatureParams& params,
+                  tbb::enumerable_thread_specific<Scratch>& scratches, RowFor&& row_for,
+                  RowWritten&& row_written) {
+  const PointKernel kernel = point_kernel();
   geometry::NeighbourhoodParams search;
   search.k = params.scales[0];
   ProgressBar progress("features", cloud.size());
   const geometry::NeighbourhoodStats stats = geometry::for_each_neighbourhood(
       cloud, search,
       [&](const geometry::Neighbourhood& nb) {
-        point_features(nb, params.scales, scratches.local(), features.row(nb.point));
+        Scratch& scratch = scratches.local();
+        kernel(nb, params.scales, scratch, row_for(nb.point, scratch));
+        row_written(nb.point, scratch);
       },
       [&](std::size_t done) { progress.advance(done); });
   log().debug(
       "neighbourhoods: {} points, {} grid cells of {:.4g}, {} queries retried on a larger "
       "block, {} answered by the k-d tree",
       cloud.size(), stats.cells, stats.cell_size, stats.retried_queries, stats.fallback_queries);
+}
+
+}  // namespace
+
+FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& params) {
+  check_cloud(cloud, params);
+  FeatureMatrix features;
+  features.points = cloud.size();
+  features.scales = static_cast<int>(params.scales.size());
+  features.values.resize(features.points * features.row_size());
+  tbb::enumerable_thread_specific<Scratch> scratches;
+  compute_rows(
+      cloud, params, scratches, [&](std::uint32_t point, Scratch&) { return features.row(point); },
+      [](std::uint32_t, Scratch&) {});
   return features;
+}
+
+void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& params,
+                                std::size_t block_size, const FeatureBlockConsumer& consume) {
+  check_cloud(cloud, params);
+  if (block_size == 0) throw Error("", "block size", "must be at least 1");
+  const std::size_t row_size = params.scales.size() * kFeaturesPerScale;
+  tbb::enumerable_thread_specific<Scratch> scratches;
+  compute_rows(
+      cloud, params, scratches,
+      [&](std::uint32_t point, Scratch& scratch) {
+        scratch.block_rows.resize(block_size * row_size);
+        scratch.block_points.push_back(point);
+        return scratch.block_rows.data() + (scratch.block_points.size() - 1) * row_size;
+      },
+      [&](std::uint32_t, Scratch& scratch) {
+        if (scratch.block_points.size() < block_size) return;
+        consume(scratch.block_points.data(), scratch.block_rows.data(), block_size);
+        scratch.block_points.clear();
+      });
+  // Each thread's last, partial block.
+  for (Scratch& scratch : scratches) {
+    if (scratch.block_points.empty()) continue;
+    consume(scratch.block_points.data(), scratch.block_rows.data(), scratch.block_points.size());
+    scratch.block_points.clear();
+  }
 }
 
 }  // namespace glint::edges

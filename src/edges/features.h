@@ -21,6 +21,8 @@
 // and concave creases look alike and removes the sign ambiguity of the eigenvector.
 // An empty subset contributes zeros.
 #include <cstddef>
+#include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "core/point_cloud.h"
@@ -53,7 +55,16 @@ struct FeatureMatrix {
 // Runs in parallel (TBB) and shows a progress bar on a terminal.
 FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& params = {});
 
-// Validates scales (>= 3, strictly decreasing); throws glint::Error naming the problem.
+// The same features handed over in blocks as they are computed, never all stored (a 1M-point
+// cloud's rows are 192 MB): consume(points, rows, count) gets up to block_size point indices
+// and their rows (row-major, scales·12 floats each), from several threads at once; every
+// point comes in exactly one block. Same checks and errors as compute_features.
+using FeatureBlockConsumer =
+    std::function<void(const std::uint32_t* points, const float* rows, std::size_t count)>;
+void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& params,
+                                std::size_t block_size, const FeatureBlockConsumer& consume);
+
+// Validates scales (>= 6, strictly decreasing); throws glint::Error naming the problem.
 void check_scales(const std::vector<int>& scales);
 
 }  // namespace glint::edges

@@ -16,8 +16,7 @@ namespace {
 
 constexpr const char* kFormatName = "glint-bounded-model";
 constexpr int kFormatVersion = 1;
-// Points per inference batch: activations of a batch stay in L1/L2 cache.
-constexpr std::size_t kBatch = 256;
+constexpr std::size_t kBatch = Model::kBatch;
 
 const std::vector<std::string>& class_names(int classes) {
   static const std::vector<std::string> three{"non-edge", "sharp-edge", "boundary"};
@@ -31,6 +30,11 @@ bool is_power_of_two(std::size_t n) { return n != 0 && (n & (n - 1)) == 0; }
 // ---- feature r of every point, so the innermost loops run over points and vectorise.
 
 // output rows [0, outputs) = weights * input rows [0, inputs) + bias, for `count` points.
+// Both layer kernels are also compiled for x86-64-v3: eight lanes and fused multiply-adds
+// (logits then differ from the baseline's by float rounding).
+#if defined(__x86_64__)
+__attribute__((target_clones("arch=x86-64-v3", "default")))
+#endif
 void apply_dense(const DenseLayer& layer, const float* input, float* output, std::size_t count) {
   for (int o = 0; o < layer.outputs; ++o) {
     float* out = output + static_cast<std::size_t>(o) * kBatch;
@@ -45,6 +49,9 @@ void apply_dense(const DenseLayer& layer, const float* input, float* output, std
   }
 }
 
+#if defined(__x86_64__)
+__attribute__((target_clones("arch=x86-64-v3", "default")))
+#endif
 void apply_leaky_relu(float* rows, int row_count, std::size_t count, float slope) {
   for (int r = 0; r < row_count; ++r) {
     float* row = rows + static_cast<std::size_t>(r) * kBatch;
@@ -248,76 +255,80 @@ void Model::check_features(const FeatureMatrix& features) const {
                             features.values.size()));
 }
 
+void Model::predict_rows(const float* rows, std::size_t count, float* probabilities,
+                         std::uint8_t* labels, PredictScratch& scratch) const {
+  const int scales = static_cast<int>(config.scales.size());
+  const std::size_t columns = static_cast<std::size_t>(scales) * kFeaturesPerScale;
+  const std::size_t classes = static_cast<std::size_t>(config.classes);
+  std::size_t widest = columns;
+  for (const DenseLayer& layer : layers)
+    widest = std::max(widest, static_cast<std::size_t>(layer.outputs));
+  scratch.a.resize(widest * kBatch);
+  scratch.b.resize(widest * kBatch);
+  float* current = scratch.a.data();
+  float* next = scratch.b.data();
+
+  // Standardised inputs, transposed to feature-major.
+  for (std::size_t b = 0; b < count; ++b) {
+    const float* row = rows + b * columns;
+    for (std::size_t c = 0; c < columns; ++c)
+      current[c * kBatch + b] = (row[c] - input_mean[c]) / input_std[c];
+  }
+
+  // Fusion tree: node j of a level reads vectors 2j and 2j+1 (adjacent rows) and writes
+  // vector j of the next level.
+  std::size_t layer_index = 0;
+  int width = kFeaturesPerScale;
+  for (int vectors = scales; vectors > 2; vectors /= 2, width = config.fusion_width) {
+    for (int node = 0; node < vectors / 2; ++node) {
+      const DenseLayer& layer = layers[layer_index++];
+      float* out = next + static_cast<std::size_t>(node) * layer.outputs * kBatch;
+      apply_dense(layer, current + static_cast<std::size_t>(2 * node) * width * kBatch, out, count);
+      apply_leaky_relu(out, layer.outputs, count, config.leaky_slope);
+    }
+    std::swap(current, next);
+  }
+  // Head.
+  for (int h = 0; h < config.hidden_layers; ++h) {
+    const DenseLayer& layer = layers[layer_index++];
+    apply_dense(layer, current, next, count);
+    apply_leaky_relu(next, layer.outputs, count, config.leaky_slope);
+    std::swap(current, next);
+  }
+  apply_dense(layers[layer_index], current, next, count);
+
+  // Softmax and argmax per point.
+  for (std::size_t b = 0; b < count; ++b) {
+    float* out = probabilities + b * classes;
+    float max_logit = next[b];
+    std::size_t best = 0;
+    for (std::size_t c = 1; c < classes; ++c)
+      if (next[c * kBatch + b] > max_logit) {
+        max_logit = next[c * kBatch + b];
+        best = c;
+      }
+    float sum = 0.0f;
+    for (std::size_t c = 0; c < classes; ++c) {
+      out[c] = std::exp(next[c * kBatch + b] - max_logit);
+      sum += out[c];
+    }
+    for (std::size_t c = 0; c < classes; ++c) out[c] /= sum;
+    labels[b] = static_cast<std::uint8_t>(best);
+  }
+}
+
 void Model::predict(const FeatureMatrix& features, std::vector<float>& probabilities,
                     std::vector<std::uint8_t>& labels) const {
   check();
   check_features(features);
-  const int scales = static_cast<int>(config.scales.size());
-  const std::size_t columns = features.row_size();
-
   const std::size_t classes = static_cast<std::size_t>(config.classes);
   probabilities.resize(features.points * classes);
   labels.resize(features.points);
-
-  std::size_t widest = columns;
-  for (const DenseLayer& layer : layers)
-    widest = std::max(widest, static_cast<std::size_t>(layer.outputs));
-
   parallel_for_chunks(features.points, kBatch, [&](std::size_t chunk_begin, std::size_t chunk_end) {
-    std::vector<float> buffer_a(widest * kBatch), buffer_b(widest * kBatch);
+    PredictScratch scratch;
     for (std::size_t begin = chunk_begin; begin < chunk_end; begin += kBatch) {
-      const std::size_t count = std::min(kBatch, chunk_end - begin);
-      float* current = buffer_a.data();
-      float* next = buffer_b.data();
-
-      // Standardised inputs, transposed to feature-major.
-      for (std::size_t b = 0; b < count; ++b) {
-        const float* row = features.row(begin + b);
-        for (std::size_t c = 0; c < columns; ++c)
-          current[c * kBatch + b] = (row[c] - input_mean[c]) / input_std[c];
-      }
-
-      // Fusion tree: node j of a level reads vectors 2j and 2j+1 (adjacent rows) and writes
-      // vector j of the next level.
-      std::size_t layer_index = 0;
-      int width = kFeaturesPerScale;
-      for (int vectors = scales; vectors > 2; vectors /= 2, width = config.fusion_width) {
-        for (int node = 0; node < vectors / 2; ++node) {
-          const DenseLayer& layer = layers[layer_index++];
-          float* out = next + static_cast<std::size_t>(node) * layer.outputs * kBatch;
-          apply_dense(layer, current + static_cast<std::size_t>(2 * node) * width * kBatch, out,
-                      count);
-          apply_leaky_relu(out, layer.outputs, count, config.leaky_slope);
-        }
-        std::swap(current, next);
-      }
-      // Head.
-      for (int h = 0; h < config.hidden_layers; ++h) {
-        const DenseLayer& layer = layers[layer_index++];
-        apply_dense(layer, current, next, count);
-        apply_leaky_relu(next, layer.outputs, count, config.leaky_slope);
-        std::swap(current, next);
-      }
-      apply_dense(layers[layer_index], current, next, count);
-
-      // Softmax and argmax per point.
-      for (std::size_t b = 0; b < count; ++b) {
-        float* out = probabilities.data() + (begin + b) * classes;
-        float max_logit = next[b];
-        std::size_t best = 0;
-        for (std::size_t c = 1; c < classes; ++c)
-          if (next[c * kBatch + b] > max_logit) {
-            max_logit = next[c * kBatch + b];
-            best = c;
-          }
-        float sum = 0.0f;
-        for (std::size_t c = 0; c < classes; ++c) {
-          out[c] = std::exp(next[c * kBatch + b] - max_logit);
-          sum += out[c];
-        }
-        for (std::size_t c = 0; c < classes; ++c) out[c] /= sum;
-        labels[begin + b] = static_cast<std::uint8_t>(best);
-      }
+      predict_rows(features.row(begin), std::min(kBatch, chunk_end - begin),
+                   probabilities.data() + begin * classes, labels.data() + begin, scratch);
     }
   });
 }

@@ -86,6 +86,19 @@ class Model {
   // probabilities (compute_features never produces them).
   void predict(const FeatureMatrix& features, std::vector<float>& probabilities,
                std::vector<std::uint8_t>& labels) const;
+
+  // Points per network pass: the inner loops run over them, and a pass's activations stay in
+  // L1/L2 cache.
+  static constexpr std::size_t kBatch = 256;
+  // Working memory of predict_rows, reused between calls.
+  struct PredictScratch {
+    std::vector<float> a, b;
+  };
+  // The same for count <= kBatch points whose feature rows are contiguous at `rows` (the
+  // model's row size each): probabilities (count x classes) and labels. No checks: call
+  // check() first.
+  void predict_rows(const float* rows, std::size_t count, float* probabilities,
+                    std::uint8_t* labels, PredictScratch& scratch) const;
 };
 
 }  // namespace glint::edges

@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <random>
+#include <vector>
 
 #include "core/error.h"
 
@@ -112,6 +115,31 @@ TEST(Features, ValuesAreFiniteAndOrderIndependentOfThreads) {
     ASSERT_TRUE(std::isfinite(a.values[i]));
     ASSERT_EQ(a.values[i], b.values[i]);
   }
+}
+
+TEST(Features, BlocksHoldEveryPointOnceWithTheMatrixRows) {
+  std::mt19937 rng(5);
+  PointCloud cloud;
+  add_patch(cloud, 30, 40, h, rng,
+            [](float u, float v) { return Eigen::Vector3f(u, v, u > 0.15f ? u - 0.15f : 0.f); });
+  const FeatureMatrix matrix = compute_features(cloud);
+  std::mutex mutex;
+  std::vector<int> seen(cloud.size(), 0);
+  std::size_t mismatches = 0, largest_block = 0;
+  compute_features_in_blocks(
+      cloud, {}, 100, [&](const std::uint32_t* points, const float* rows, std::size_t count) {
+        std::lock_guard<std::mutex> lock(mutex);
+        largest_block = std::max(largest_block, count);
+        for (std::size_t b = 0; b < count; ++b) {
+          ++seen[points[b]];
+          for (std::size_t c = 0; c < matrix.row_size(); ++c)
+            mismatches += rows[b * matrix.row_size() + c] != matrix.row(points[b])[c];
+        }
+      });
+  EXPECT_EQ(mismatches, 0u);
+  EXPECT_EQ(largest_block, 100u);
+  EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int n) { return n == 1; }));
+  EXPECT_THROW(compute_features_in_blocks(cloud, {}, 0, [](auto...) {}), glint::Error);
 }
 
 TEST(Features, RejectsBadInputs) {

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "core/error.h"
+#include "edges/classifier.h"
 
 namespace glint::edges {
 namespace {
@@ -133,6 +134,31 @@ TEST(ModelTest, RejectsConfigsThatDescribeNoNetwork) {
   rejects([](ModelConfig& c) { c.hidden = 0; });
   rejects([](ModelConfig& c) { c.leaky_slope = std::nanf(""); });
   EXPECT_NO_THROW(check_config(ModelConfig{}));
+}
+
+TEST(ModelTest, ClassifyGivesEveryPointItsOwnFeaturesResult) {
+  // classify() runs the network on blocks of features as they are computed, in the search's
+  // order: each point must still get the result of its own row.
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  PointCloud cloud;
+  for (int i = 0; i < 3000; ++i) {
+    const float a = u(rng), b = u(rng);
+    cloud.push_back(a, b, std::abs(a - 0.5f));  // a crease along a = 0.5
+  }
+  ModelConfig config;
+  config.leaky_slope = 0.1f;
+  const Model model = random_model(config, 11);
+  const Classification fused = classify(cloud, model);
+  const Classification apart = classify_features(compute_features(cloud), model);
+  ASSERT_EQ(fused.labels.size(), cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    ASSERT_EQ(fused.labels[i], apart.labels[i]) << "point " << i;
+    ASSERT_NEAR(fused.p_sharp[i], apart.p_sharp[i], 1e-6f) << "point " << i;
+    ASSERT_NEAR(fused.p_boundary[i], apart.p_boundary[i], 1e-6f) << "point " << i;
+  }
+  EXPECT_GE(fused.features_s, 0.0);
+  EXPECT_GE(fused.inference_s, 0.0);
 }
 
 TEST(ModelTest, ZeroWeightsGiveTheSoftmaxOfTheOutputBias) {
