@@ -9,6 +9,16 @@
 #include "core/timer.h"
 
 namespace glint::edges {
+namespace {
+
+// One point's softmax probabilities (class order) into the result's columns.
+void keep_probabilities(Classification& result, std::size_t point, const float* p,
+                        std::size_t classes) {
+  result.p_sharp[point] = p[1];
+  if (classes > 2) result.p_boundary[point] = p[2];
+}
+
+}  // namespace
 
 Classification classify(const PointCloud& cloud, const Model& model,
                         const std::vector<int>& scales) {
@@ -35,22 +45,23 @@ Classification classify(const PointCloud& cloud, const Model& model,
     std::vector<std::uint8_t> labels;
     double network_s = 0;
   };
-  tbb::enumerable_thread_specific<Worker> workers;
+  tbb::enumerable_thread_specific<Worker> workers([classes] {
+    Worker worker;
+    worker.probabilities.resize(Model::kBatch * classes);
+    worker.labels.resize(Model::kBatch);
+    return worker;
+  });
   const Stopwatch watch;
   compute_features_in_blocks(
       cloud, params, Model::kBatch,
       [&](const std::uint32_t* points, const float* rows, std::size_t count) {
         Worker& worker = workers.local();
         const Stopwatch network_watch;
-        worker.probabilities.resize(Model::kBatch * classes);
-        worker.labels.resize(Model::kBatch);
         model.predict_rows(rows, count, worker.probabilities.data(), worker.labels.data(),
                            worker.scratch);
         for (std::size_t b = 0; b < count; ++b) {
-          const float* p = worker.probabilities.data() + b * classes;
           result.labels[points[b]] = worker.labels[b];
-          result.p_sharp[points[b]] = p[1];
-          if (classes > 2) result.p_boundary[points[b]] = p[2];
+          keep_probabilities(result, points[b], worker.probabilities.data() + b * classes, classes);
         }
         worker.network_s += network_watch.elapsed_s();
       });
@@ -73,10 +84,8 @@ Classification classify_features(const FeatureMatrix& features, const Model& mod
   const std::size_t classes = static_cast<std::size_t>(model.config.classes);
   result.p_sharp.resize(features.points);
   result.p_boundary.assign(features.points, 0.f);
-  for (std::size_t i = 0; i < features.points; ++i) {
-    result.p_sharp[i] = probabilities[i * classes + 1];
-    if (classes > 2) result.p_boundary[i] = probabilities[i * classes + 2];
-  }
+  for (std::size_t i = 0; i < features.points; ++i)
+    keep_probabilities(result, i, probabilities.data() + i * classes, classes);
   return result;
 }
 

@@ -322,7 +322,7 @@ void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& pa
   compute_rows(
       cloud, params, scratches,
       [&](std::uint32_t point, Scratch& scratch) {
-        scratch.block_rows.resize(block_size * row_size);
+        if (scratch.block_points.empty()) scratch.block_rows.resize(block_size * row_size);
         scratch.block_points.push_back(point);
         return scratch.block_rows.data() + (scratch.block_points.size() - 1) * row_size;
       },

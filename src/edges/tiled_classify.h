@@ -62,8 +62,8 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
                                 const Model& model, const TiledClassifyParams& params = {});
 
 // Bytes per point a tile may need while it is classified (positions, neighbour grid, network
-// outputs), measured with some margin. Conservative: it still counts a feature matrix at four
-// scales (192 bytes per point), which classify() no longer stores.
+// outputs), measured with some margin. Conservative: it counts a feature matrix at four scales
+// (192 bytes per point) that classify() does not store.
 inline constexpr std::uint64_t kTileBytesPerPoint = 320;
 
 // Parses a memory size such as "2G", "512M", "1.5G" or "1000000" (bytes); throws glint::Error.

@@ -265,13 +265,25 @@ inline std::uint64_t pack(float squared_distance, std::size_t candidate) {
 // Candidates compacted per step by the AVX-512 path (it may write this many past the last).
 constexpr std::size_t kCompactLanes = 16;
 
+// Appends to within[kept...] the indices j in [first, count) with distances[j] <= limit
+// (branch-free) and returns the new count.
+inline std::size_t compact_within(const float* distances, std::size_t first, std::size_t count,
+                                  float limit, std::uint32_t* within, std::size_t kept) {
+  for (std::size_t j = first; j < count; ++j) {
+    within[kept] = static_cast<std::uint32_t>(j);
+    kept += distances[j] <= limit;
+  }
+  return kept;
+}
+
 #if defined(__x86_64__)
-// Indices of the candidates with squared distance <= limit, sixteen candidates per step,
-// compressed in a register (the memory form of vpcompressd is microcoded on AMD Zen 4).
-[[gnu::target("arch=x86-64-v4")]] inline std::size_t compact_within_avx512(const float* distances,
-                                                                           std::size_t count,
-                                                                           float limit,
-                                                                           std::uint32_t* within) {
+// The same for whole steps of sixteen candidates, compressed in a register (the memory form of
+// vpcompressd is microcoded on AMD Zen 4); `scanned` gets where the steps ended.
+[[gnu::target("arch=x86-64-v4")]] inline std::size_t compact_steps_avx512(const float* distances,
+                                                                          std::size_t count,
+                                                                          float limit,
+                                                                          std::uint32_t* within,
+                                                                          std::size_t& scanned) {
   const __m512 bound = _mm512_set1_ps(limit);
   const __m512i step = _mm512_set1_epi32(int(kCompactLanes));
   __m512i index = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
@@ -282,16 +294,13 @@ constexpr std::size_t kCompactLanes = 16;
     kept += std::popcount(static_cast<unsigned>(inside));
     index = _mm512_add_epi32(index, step);
   }
-  for (; j < count; ++j) {
-    within[kept] = static_cast<std::uint32_t>(j);
-    kept += distances[j] <= limit;
-  }
+  scanned = j;
   return kept;
 }
 #endif
 
 // Writes the candidates with squared distance <= limit to `sorted`, the first k of them in
-// increasing order, and returns how many there are. They are first compacted (branch-free),
+// increasing order, and returns how many there are. They are first compacted,
 // then counting-sorted into buckets of equal squared distance, and an insertion sort fixes the
 // order inside each bucket.
 template <bool kAvx512>
@@ -299,16 +308,11 @@ std::size_t bucket_sort_within(const float* distances, std::size_t count, float 
                                Scratch& scratch, std::uint64_t* sorted) {
   scratch.within.resize(count + kCompactLanes);
   std::uint32_t* within = scratch.within.data();
-  std::size_t kept = 0;
+  std::size_t kept = 0, scanned = 0;
 #if defined(__x86_64__)
-  if constexpr (kAvx512) kept = compact_within_avx512(distances, count, limit, within);
+  if constexpr (kAvx512) kept = compact_steps_avx512(distances, count, limit, within, scanned);
 #endif
-  if constexpr (!kAvx512) {
-    for (std::size_t j = 0; j < count; ++j) {
-      within[kept] = static_cast<std::uint32_t>(j);
-      kept += distances[j] <= limit;
-    }
-  }
+  kept = compact_within(distances, scanned, count, limit, within, kept);
   constexpr int buckets = Scratch::kBuckets;
   std::array<std::uint32_t, buckets>& begin = scratch.bucket_start;
   begin.fill(0);
