@@ -5,7 +5,11 @@
 // Writes JSON (stdout, or --json FILE) with the machine and the parameters it ran with.
 //
 //   edges_throughput [--points 1000000] [--model models/bounded-3c.json] [--data DIR] [--json F]
+//                    [--repeat 1]
+// --repeat N classifies and searches N times and reports the median (and every run): on a
+// shared host single runs of the same binary vary by a quarter.
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <iostream>
@@ -39,6 +43,12 @@ glint::PointCloud benchmark_cloud(std::size_t n) {
   return glint::edges::synthesize_cloud(params, 0).cloud;
 }
 
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
 std::string arg_value(int argc, char** argv, const std::string& name, const std::string& fallback) {
   for (int i = 1; i + 1 < argc; ++i) {
     if (argv[i] == name) return argv[i + 1];
@@ -57,29 +67,27 @@ int main(int argc, char** argv) {
   const std::string folder =
       arg_value(argc, argv, "--folder", data_root + "/pointclouds/default-eval");
   const std::string json_path = arg_value(argc, argv, "--json", "");
+  const int repeat = std::max(1, std::stoi(arg_value(argc, argv, "--repeat", "1")));
 
   nlohmann::json report;
   report["machine"] = {{"cpu", glint::bench::cpu_model()},
                        {"hardware_threads", std::thread::hardware_concurrency()}};
-  report["parameters"] = {{"points", points}, {"model", model_path}, {"folder", folder}};
+  report["parameters"] = {
+      {"points", points}, {"model", model_path}, {"folder", folder}, {"repeat", repeat}};
 
   const glint::edges::Model model = glint::edges::Model::load(model_path);
 
   const glint::PointCloud cloud = benchmark_cloud(points);
   const double rss_before_mib = glint::bench::peak_rss_mib();
-  const glint::edges::Classification result = glint::edges::classify(cloud, model);
-  const double total_s = result.features_s + result.inference_s;
-  report["generated"] = {{"points", points},
-                         {"features_s", result.features_s},
-                         {"inference_s", result.inference_s},
-                         {"total_s", total_s},
-                         {"points_per_s", double(points) / total_s},
-                         {"peak_rss_mib", glint::bench::peak_rss_mib()},
-                         {"peak_rss_before_features_mib", rss_before_mib}};
+  std::vector<double> features_runs, inference_runs, total_runs, search_runs;
+  for (int run = 0; run < repeat; ++run) {
+    const glint::edges::Classification result = glint::edges::classify(cloud, model);
+    features_runs.push_back(result.features_s);
+    inference_runs.push_back(result.inference_s);
+    total_runs.push_back(result.features_s + result.inference_s);
 
-  // The neighbourhood search alone (the features' visitor replaced by a checksum), so the
-  // split between search and features is measured rather than guessed.
-  {
+    // The neighbourhood search alone (the features' visitor replaced by a checksum), so the
+    // split between search and features is measured rather than guessed.
     glint::geometry::NeighbourhoodParams search;
     search.k = model.config.scales.front();
     std::atomic<std::uint64_t> checksum{0};
@@ -87,8 +95,19 @@ int main(int argc, char** argv) {
     glint::geometry::for_each_neighbourhood(cloud, search, [&](const auto& neighbourhood) {
       checksum.fetch_add(neighbourhood.indices[neighbourhood.size - 1], std::memory_order_relaxed);
     });
-    report["generated"]["search_only_s"] = search_watch.elapsed_s();
+    search_runs.push_back(search_watch.elapsed_s());
   }
+  const double total_s = median(total_runs);
+  report["generated"] = {{"points", points},
+                         {"features_s", median(features_runs)},
+                         {"inference_s", median(inference_runs)},
+                         {"total_s", total_s},
+                         {"points_per_s", double(points) / total_s},
+                         {"search_only_s", median(search_runs)},
+                         {"total_s_runs", total_runs},
+                         {"search_only_s_runs", search_runs},
+                         {"peak_rss_mib", glint::bench::peak_rss_mib()},
+                         {"peak_rss_before_features_mib", rss_before_mib}};
 
   const glint::Stopwatch watch;
   glint::edges::classify_covariance_baseline(cloud);

@@ -13,7 +13,6 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
-#include <numeric>
 #include <random>
 #include <string>
 #include <utility>
@@ -200,13 +199,16 @@ Grid build_grid(const PointCloud& cloud, double cell_size) {
 // Per-thread working memory, reused across cells (no allocation per point).
 struct Scratch {
   std::vector<float> cx, cy, cz;      // gathered candidates
-  std::vector<std::uint32_t> cslot;   // their sorted-slot index
+  std::vector<std::uint32_t> cindex;  // their index in the cloud
   std::vector<float> distances;       // squared distance of each candidate to the query
   std::vector<std::uint64_t> ranked;  // (squared distance bits << 32) | candidate
   float previous_kth = 0;             // k-th squared distance of the previous query
-  static constexpr int kBuckets = 128;
+  // About three buckets per candidate (the range holds ~1.25 k of them): most buckets hold
+  // one, so the insertion sort seldom moves anything.
+  static constexpr int kBuckets = 512;
   std::vector<std::uint32_t> within;     // candidates inside the bucket range
-  std::vector<std::uint16_t> bucket_of;  // bucket of each of them
+  std::vector<float> within_distance;    // their squared distances
+  std::vector<std::uint16_t> bucket_of;  // and buckets
   std::array<std::uint32_t, kBuckets> bucket_start{};
   std::vector<float> dx, dy, dz;  // accepted neighbourhood, relative to the query
   std::vector<std::uint32_t> indices;
@@ -221,7 +223,7 @@ void gather_block(const Grid& grid, std::size_t cell, int radius, Scratch& scrat
   scratch.cx.clear();
   scratch.cy.clear();
   scratch.cz.clear();
-  scratch.cslot.clear();
+  scratch.cindex.clear();
   const auto rows = static_cast<std::uint64_t>(grid.dims[1]);
   const std::int64_t c[3] = {static_cast<std::int64_t>(grid.cell_column[cell] / rows),
                              static_cast<std::int64_t>(grid.cell_column[cell] % rows),
@@ -249,9 +251,8 @@ void gather_block(const Grid& grid, std::size_t cell, int radius, Scratch& scrat
       scratch.cx.insert(scratch.cx.end(), grid.xs.begin() + begin, grid.xs.begin() + end);
       scratch.cy.insert(scratch.cy.end(), grid.ys.begin() + begin, grid.ys.begin() + end);
       scratch.cz.insert(scratch.cz.end(), grid.zs.begin() + begin, grid.zs.begin() + end);
-      const std::size_t at = scratch.cslot.size();
-      scratch.cslot.resize(at + (end - begin));
-      std::iota(scratch.cslot.begin() + at, scratch.cslot.end(), begin);
+      scratch.cindex.insert(scratch.cindex.end(), grid.original.begin() + begin,
+                            grid.original.begin() + end);
     }
   }
 }
@@ -265,12 +266,14 @@ inline std::uint64_t pack(float squared_distance, std::size_t candidate) {
 // Candidates compacted per step by the AVX-512 path (it may write this many past the last).
 constexpr std::size_t kCompactLanes = 16;
 
-// Appends to within[kept...] the indices j in [first, count) with distances[j] <= limit
-// (branch-free) and returns the new count.
+// Appends to within[kept...] the indices j in [first, count) with distances[j] <= limit, and
+// their distances to within_distance[kept...] (branch-free); returns the new count.
 inline std::size_t compact_within(const float* distances, std::size_t first, std::size_t count,
-                                  float limit, std::uint32_t* within, std::size_t kept) {
+                                  float limit, std::uint32_t* within, float* within_distance,
+                                  std::size_t kept) {
   for (std::size_t j = first; j < count; ++j) {
     within[kept] = static_cast<std::uint32_t>(j);
+    within_distance[kept] = distances[j];
     kept += distances[j] <= limit;
   }
   return kept;
@@ -279,23 +282,51 @@ inline std::size_t compact_within(const float* distances, std::size_t first, std
 #if defined(__x86_64__)
 // The same for whole steps of sixteen candidates, compressed in a register (the memory form of
 // vpcompressd is microcoded on AMD Zen 4); `scanned` gets where the steps ended.
-[[gnu::target("arch=x86-64-v4")]] inline std::size_t compact_steps_avx512(const float* distances,
-                                                                          std::size_t count,
-                                                                          float limit,
-                                                                          std::uint32_t* within,
-                                                                          std::size_t& scanned) {
+[[gnu::target("arch=x86-64-v4")]] inline std::size_t compact_steps_avx512(
+    const float* distances, std::size_t count, float limit, std::uint32_t* within,
+    float* within_distance, std::size_t& scanned) {
   const __m512 bound = _mm512_set1_ps(limit);
   const __m512i step = _mm512_set1_epi32(int(kCompactLanes));
   __m512i index = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
   std::size_t kept = 0, j = 0;
   for (; j + kCompactLanes <= count; j += kCompactLanes) {
-    const __mmask16 inside = _mm512_cmp_ps_mask(_mm512_loadu_ps(distances + j), bound, _CMP_LE_OQ);
+    const __m512 distance = _mm512_loadu_ps(distances + j);
+    const __mmask16 inside = _mm512_cmp_ps_mask(distance, bound, _CMP_LE_OQ);
     _mm512_storeu_si512(within + kept, _mm512_maskz_compress_epi32(inside, index));
+    _mm512_storeu_ps(within_distance + kept, _mm512_maskz_compress_ps(inside, distance));
     kept += std::popcount(static_cast<unsigned>(inside));
     index = _mm512_add_epi32(index, step);
   }
   scanned = j;
   return kept;
+}
+#endif
+
+// Turns bucket counts into each bucket's first position (a serial scan; the AVX-512 path has
+// its own below).
+inline void exclusive_scan_buckets(std::uint32_t* counts) {
+  std::uint32_t offset = 0;
+  for (int b = 0; b < Scratch::kBuckets; ++b) offset += std::exchange(counts[b], offset);
+}
+
+#if defined(__x86_64__)
+static_assert(Scratch::kBuckets % 16 == 0);
+// Sixteen buckets at a time: an in-register inclusive scan (shifts by 1, 2, 4 and 8 lanes),
+// minus the counts themselves, plus the total of the buckets before.
+[[gnu::target("arch=x86-64-v4")]] inline void exclusive_scan_buckets_avx512(std::uint32_t* counts) {
+  const __m512i zero = _mm512_setzero_si512();
+  const __m512i last_lane = _mm512_set1_epi32(15);
+  __m512i carry = zero;
+  for (int b = 0; b < Scratch::kBuckets; b += 16) {
+    const __m512i count = _mm512_loadu_si512(counts + b);
+    __m512i sum = _mm512_add_epi32(count, _mm512_maskz_alignr_epi32(0xFFFF, count, zero, 15));
+    sum = _mm512_add_epi32(sum, _mm512_maskz_alignr_epi32(0xFFFF, sum, zero, 14));
+    sum = _mm512_add_epi32(sum, _mm512_maskz_alignr_epi32(0xFFFF, sum, zero, 12));
+    sum = _mm512_add_epi32(sum, _mm512_maskz_alignr_epi32(0xFFFF, sum, zero, 8));
+    sum = _mm512_add_epi32(sum, carry);
+    _mm512_storeu_si512(counts + b, _mm512_sub_epi32(sum, count));
+    carry = _mm512_maskz_permutexvar_epi32(0xFFFF, last_lane, sum);
+  }
 }
 #endif
 
@@ -307,36 +338,38 @@ template <bool kAvx512>
 std::size_t bucket_sort_within(const float* distances, std::size_t count, float limit, int k,
                                Scratch& scratch, std::uint64_t* sorted) {
   scratch.within.resize(count + kCompactLanes);
+  scratch.within_distance.resize(count + kCompactLanes);
   std::uint32_t* within = scratch.within.data();
+  float* within_distance = scratch.within_distance.data();
   std::size_t kept = 0, scanned = 0;
 #if defined(__x86_64__)
-  if constexpr (kAvx512) kept = compact_steps_avx512(distances, count, limit, within, scanned);
+  if constexpr (kAvx512)
+    kept = compact_steps_avx512(distances, count, limit, within, within_distance, scanned);
 #endif
-  kept = compact_within(distances, scanned, count, limit, within, kept);
+  kept = compact_within(distances, scanned, count, limit, within, within_distance, kept);
   constexpr int buckets = Scratch::kBuckets;
-  std::array<std::uint32_t, buckets>& begin = scratch.bucket_start;
-  begin.fill(0);
+  std::uint32_t* start = scratch.bucket_start.data();
+  std::fill(start, start + buckets, 0u);
   scratch.bucket_of.resize(kept);
   std::uint16_t* bucket_of = scratch.bucket_of.data();
   const float to_bucket = float(buckets) / limit;
-  for (std::size_t i = 0; i < kept; ++i) {
-    bucket_of[i] =
-        static_cast<std::uint16_t>(std::min(int(distances[within[i]] * to_bucket), buckets - 1));
-    ++begin[bucket_of[i]];
-  }
-  std::uint32_t offset = 0;
-  for (auto& entry : begin) offset += std::exchange(entry, offset);
-  std::array<std::uint32_t, buckets> next = begin;
+  // Two loops: the first runs in vector lanes, the second is the serial count.
   for (std::size_t i = 0; i < kept; ++i)
-    sorted[next[bucket_of[i]]++] = pack(distances[within[i]], within[i]);
+    bucket_of[i] =
+        static_cast<std::uint16_t>(std::min(int(within_distance[i] * to_bucket), buckets - 1));
+  for (std::size_t i = 0; i < kept; ++i) ++start[bucket_of[i]];
+#if defined(__x86_64__)
+  if constexpr (kAvx512) exclusive_scan_buckets_avx512(start);
+#endif
+  if constexpr (!kAvx512) exclusive_scan_buckets(start);
+  // Scattering advances each bucket's start to its end.
+  for (std::size_t i = 0; i < kept; ++i)
+    sorted[start[bucket_of[i]]++] = pack(within_distance[i], within[i]);
   // Only the first k need their order: sort up to the end of the bucket holding position
   // k - 1 (later buckets hold only farther candidates).
   std::size_t end = kept;
-  if (kept >= static_cast<std::size_t>(k)) {
-    const auto b =
-        std::upper_bound(begin.begin(), begin.end(), std::uint32_t(k - 1)) - begin.begin() - 1;
-    end = next[b];
-  }
+  if (kept >= static_cast<std::size_t>(k))
+    end = *std::upper_bound(start, start + buckets, std::uint32_t(k - 1));
   for (std::size_t i = 1; i < end; ++i) {
     const std::uint64_t value = sorted[i];
     std::size_t j = i;
@@ -389,7 +422,7 @@ bool select_from_block(const Grid& grid, std::uint32_t slot, const double lower[
     scratch.dx[j] = cx[candidate] - qx;
     scratch.dy[j] = cy[candidate] - qy;
     scratch.dz[j] = cz[candidate] - qz;
-    scratch.indices[j] = grid.original[scratch.cslot[candidate]];
+    scratch.indices[j] = scratch.cindex[candidate];
   }
   return true;
 }
