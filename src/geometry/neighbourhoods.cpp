@@ -203,13 +203,15 @@ struct Scratch {
   std::vector<float> distances;       // squared distance of each candidate to the query
   std::vector<std::uint64_t> ranked;  // (squared distance bits << 32) | candidate
   float previous_kth = 0;             // k-th squared distance of the previous query
-  // About three buckets per candidate (the range holds ~1.25 k of them): most buckets hold
-  // one, so the insertion sort seldom moves anything.
-  static constexpr int kBuckets = 512;
+  // Distance buckets of the selection: with the AVX-512 scan about three per candidate (the
+  // range holds ~1.25 k of them), so most hold one and the insertion sort seldom moves
+  // anything; a serial scan over that many would cost more than it saves.
+  static constexpr int kBucketsAvx512 = 512;
+  static constexpr int kBuckets = 128;
   std::vector<std::uint32_t> within;     // candidates inside the bucket range
   std::vector<float> within_distance;    // their squared distances
   std::vector<std::uint16_t> bucket_of;  // and buckets
-  std::array<std::uint32_t, kBuckets> bucket_start{};
+  std::array<std::uint32_t, kBucketsAvx512> bucket_start{};
   std::vector<float> dx, dy, dz;  // accepted neighbourhood, relative to the query
   std::vector<std::uint32_t> indices;
   std::vector<std::uint32_t> retry;  // sorted slots that need a larger block
@@ -310,14 +312,14 @@ inline void exclusive_scan_buckets(std::uint32_t* counts) {
 }
 
 #if defined(__x86_64__)
-static_assert(Scratch::kBuckets % 16 == 0);
+static_assert(Scratch::kBucketsAvx512 % 16 == 0);
 // Sixteen buckets at a time: an in-register inclusive scan (shifts by 1, 2, 4 and 8 lanes),
 // minus the counts themselves, plus the total of the buckets before.
 [[gnu::target("arch=x86-64-v4")]] inline void exclusive_scan_buckets_avx512(std::uint32_t* counts) {
   const __m512i zero = _mm512_setzero_si512();
   const __m512i last_lane = _mm512_set1_epi32(15);
   __m512i carry = zero;
-  for (int b = 0; b < Scratch::kBuckets; b += 16) {
+  for (int b = 0; b < Scratch::kBucketsAvx512; b += 16) {
     const __m512i count = _mm512_loadu_si512(counts + b);
     __m512i sum = _mm512_add_epi32(count, _mm512_maskz_alignr_epi32(0xFFFF, count, zero, 15));
     sum = _mm512_add_epi32(sum, _mm512_maskz_alignr_epi32(0xFFFF, sum, zero, 14));
@@ -347,7 +349,7 @@ std::size_t bucket_sort_within(const float* distances, std::size_t count, float 
     kept = compact_steps_avx512(distances, count, limit, within, within_distance, scanned);
 #endif
   kept = compact_within(distances, scanned, count, limit, within, within_distance, kept);
-  constexpr int buckets = Scratch::kBuckets;
+  constexpr int buckets = kAvx512 ? Scratch::kBucketsAvx512 : Scratch::kBuckets;
   std::uint32_t* start = scratch.bucket_start.data();
   std::fill(start, start + buckets, 0u);
   scratch.bucket_of.resize(kept);
