@@ -6,7 +6,7 @@ BUILD=${1:?usage: bench.sh BUILD DATA}
 DATA=${2:?usage: bench.sh BUILD DATA}
 OUT=build/bench
 mkdir -p "$OUT"
-"$BUILD/bench/edges/edges_throughput" --points 1000000 --model models/bounded-3c.json \
+"$BUILD/bench/edges/edges_throughput" --points 1000000 --repeat 3 --model models/bounded-3c.json \
   --data "$DATA" --json "$OUT/edges_throughput.json"
 # The PCL / Open3D boundary peers, where they were built (scripts/install-deps.sh --peers).
 if [[ -x "$BUILD/bench/edges/boundary_peers" ]]; then
