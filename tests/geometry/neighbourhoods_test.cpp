@@ -89,5 +89,43 @@ TEST(Neighbourhoods, IdenticalPointsAndTinyClouds) {
   EXPECT_THROW(for_each_neighbourhood(same, params, [](const Neighbourhood&) {}), glint::Error);
 }
 
+TEST(Neighbourhoods, LatticesWithManyEqualDistancesComeOutSorted) {
+  // Lattices put many candidates at exactly equal distances, so distance buckets hold several
+  // and the counts cross the scan's 16-bucket steps: lists must still be sorted, nearest first,
+  // with the exact k-th distance at every prefix.
+  PointCloud plane, volume;
+  for (int i = 0; i < 60; ++i)
+    for (int j = 0; j < 60; ++j) plane.push_back(0.5f * float(i), 0.5f * float(j), 0.f);
+  for (int i = 0; i < 14; ++i)
+    for (int j = 0; j < 14; ++j)
+      for (int l = 0; l < 14; ++l) volume.push_back(float(i), float(j), float(l));
+  for (const PointCloud* cloud : {&plane, &volume}) {
+    constexpr int k = 128;
+    const KnnResult exact = KdTree(*cloud).knn_all(k);
+    std::mutex mutex;
+    std::size_t unsorted = 0, wrong_prefix = 0, visited = 0;
+    NeighbourhoodParams params;
+    params.k = k;
+    for_each_neighbourhood(*cloud, params, [&](const Neighbourhood& nb) {
+      std::size_t local_unsorted = 0, local_wrong = 0;
+      float previous = 0;
+      for (int j = 0; j < k; ++j) {
+        const float d = squared_distance(*cloud, nb.point, nb.indices[j]);
+        local_unsorted += d < previous;
+        previous = d;
+        const float expected = exact.squared_distances[std::size_t(nb.point) * k + j];
+        local_wrong += std::abs(d - expected) > 1e-6f * std::max(1.f, expected);
+      }
+      std::lock_guard<std::mutex> lock(mutex);
+      unsorted += local_unsorted;
+      wrong_prefix += local_wrong;
+      ++visited;
+    });
+    EXPECT_EQ(unsorted, 0u);
+    EXPECT_EQ(wrong_prefix, 0u);
+    EXPECT_EQ(visited, cloud->size());
+  }
+}
+
 }  // namespace
 }  // namespace glint::geometry
