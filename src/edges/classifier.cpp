@@ -11,6 +11,15 @@
 namespace glint::edges {
 namespace {
 
+// A result for n points: labels, and probability columns with boundary 0 until set.
+Classification sized_result(std::size_t n) {
+  Classification result;
+  result.labels.resize(n);
+  result.p_sharp.resize(n);
+  result.p_boundary.assign(n, 0.f);
+  return result;
+}
+
 // One point's softmax probabilities (class order) into the result's columns.
 void keep_probabilities(Classification& result, std::size_t point, const float* p,
                         std::size_t classes) {
@@ -30,12 +39,8 @@ Classification classify(const PointCloud& cloud, const Model& model,
                     " scales; got " + std::to_string(params.scales.size()));
   }
   model.check();
-  const std::size_t n = cloud.size();
   const std::size_t classes = static_cast<std::size_t>(model.config.classes);
-  Classification result;
-  result.labels.resize(n);
-  result.p_sharp.resize(n);
-  result.p_boundary.assign(n, 0.f);
+  Classification result = sized_result(cloud.size());
 
   // The network runs on each block of features as it is computed, so the rows are never all
   // stored; each thread's time is split between the two stages to report them apart.
@@ -75,15 +80,13 @@ Classification classify(const PointCloud& cloud, const Model& model,
 }
 
 Classification classify_features(const FeatureMatrix& features, const Model& model) {
-  Classification result;
+  Classification result = sized_result(features.points);
   const Stopwatch watch;
   std::vector<float> probabilities;
   model.predict(features, probabilities, result.labels);
   result.inference_s = watch.elapsed_s();
 
   const std::size_t classes = static_cast<std::size_t>(model.config.classes);
-  result.p_sharp.resize(features.points);
-  result.p_boundary.assign(features.points, 0.f);
   for (std::size_t i = 0; i < features.points; ++i)
     keep_probabilities(result, i, probabilities.data() + i * classes, classes);
   return result;

@@ -274,8 +274,8 @@ void check_cloud(const PointCloud& cloud, const FeatureParams& params) {
   }
 }
 
-// Every point's features, written to row_for(point, scratch); row_written(point, scratch)
-// follows on the same thread. The cloud must have passed check_cloud.
+// Every point's features, written to row_for(point, scratch); row_written(scratch) follows
+// on the same thread. The cloud must have passed check_cloud.
 template <class RowFor, class RowWritten>
 void compute_rows(const PointCloud& cloud, const FeatureParams& params,
                   tbb::enumerable_thread_specific<Scratch>& scratches, RowFor&& row_for,
@@ -289,7 +289,7 @@ void compute_rows(const PointCloud& cloud, const FeatureParams& params,
       [&](const geometry::Neighbourhood& nb) {
         Scratch& scratch = scratches.local();
         kernel(nb, params.scales, scratch, row_for(nb.point, scratch));
-        row_written(nb.point, scratch);
+        row_written(scratch);
       },
       [&](std::size_t done) { progress.advance(done); });
   log().debug(
@@ -309,7 +309,7 @@ FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& par
   tbb::enumerable_thread_specific<Scratch> scratches;
   compute_rows(
       cloud, params, scratches, [&](std::uint32_t point, Scratch&) { return features.row(point); },
-      [](std::uint32_t, Scratch&) {});
+      [](Scratch&) {});
   return features;
 }
 
@@ -318,15 +318,19 @@ void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& pa
   check_cloud(cloud, params);
   if (block_size == 0) throw Error("", "block size", "must be at least 1");
   const std::size_t row_size = params.scales.size() * kFeaturesPerScale;
-  tbb::enumerable_thread_specific<Scratch> scratches;
+  tbb::enumerable_thread_specific<Scratch> scratches([&] {
+    Scratch scratch;
+    scratch.block_points.reserve(block_size);
+    scratch.block_rows.resize(block_size * row_size);
+    return scratch;
+  });
   compute_rows(
       cloud, params, scratches,
       [&](std::uint32_t point, Scratch& scratch) {
-        if (scratch.block_points.empty()) scratch.block_rows.resize(block_size * row_size);
         scratch.block_points.push_back(point);
         return scratch.block_rows.data() + (scratch.block_points.size() - 1) * row_size;
       },
-      [&](std::uint32_t, Scratch& scratch) {
+      [&](Scratch& scratch) {
         if (scratch.block_points.size() < block_size) return;
         consume(scratch.block_points.data(), scratch.block_rows.data(), block_size);
         scratch.block_points.clear();
