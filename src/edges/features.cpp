@@ -4,7 +4,6 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
-#include <array>
 #include <bit>
 #include <cmath>
 #include <string>
@@ -71,6 +70,22 @@ struct Scratch {
   std::vector<Vector3d> eigenvalues;
 };
 
+// The eight bytes at `bytes` as one word, the first byte lowest (one load on little-endian
+// machines).
+std::uint64_t bytes_at(const std::uint8_t* bytes) {
+  std::uint64_t word = 0;
+  for (int b = 0; b < 8; ++b) word |= std::uint64_t(bytes[b]) << (8 * b);
+  return word;
+}
+
+// The top bit of each byte of `word` that equals `value`, others zero (exact: no carries cross
+// bytes, unlike the shorter has-zero-byte test).
+std::uint64_t bytes_equal_to(std::uint64_t word, std::uint8_t value) {
+  constexpr std::uint64_t kLow7 = 0x7f7f7f7f7f7f7f7fULL;
+  const std::uint64_t x = word ^ (0x0101010101010101ULL * value);
+  return ~(((x & kLow7) + kLow7) | x | kLow7);
+}
+
 // Moments of the `count` neighbours closest to `centre` (§5.4.1: the normal is fitted to the
 // floor(k/2) points nearest the centre of mass, which keeps it stable near outliers).
 // Bucketing by squared distance finds the cut without sorting: whole buckets below the cut are
@@ -79,7 +94,8 @@ Moments moments_nearest_to(const geometry::Neighbourhood& nb, int k, const Vecto
                            int count, Scratch& scratch) {
   constexpr int buckets = Scratch::kBuckets;
   scratch.squared_distances.resize(k);
-  scratch.bucket_of.resize(k);
+  // Padded to whole 8-byte words with a value no bucket has (bytes_equal_to reads words).
+  scratch.bucket_of.assign(std::size_t(k + 7) / 8 * 8, std::uint8_t(0xff));
   float* d2 = scratch.squared_distances.data();
   const float cx = float(centre.x()), cy = float(centre.y()), cz = float(centre.z());
   // The largest squared distance as the maximum of its bit patterns (the same order for
@@ -95,15 +111,32 @@ Moments moments_nearest_to(const geometry::Neighbourhood& nb, int k, const Vecto
   std::uint8_t* bucket_of = scratch.bucket_of.data();
   for (int j = 0; j < k; ++j)
     bucket_of[j] = std::uint8_t(std::min(int(d2[j] * to_bucket), buckets - 1));
-  std::array<int, buckets + 1> histogram{};
-  for (int j = 0; j < k; ++j) ++histogram[bucket_of[j]];
-  int cut = 0, below = 0;
-  while (below + histogram[cut] < count) below += histogram[cut++];
+  // The cut is the first bucket whose cumulative count reaches `count`, found by bisection
+  // over vectorised counts (a histogram's increments form a store-to-load chain).
+  const auto at_most = [&](int bucket) {
+    int n = 0;
+    for (int j = 0; j < k; ++j) n += bucket_of[j] <= bucket ? 1 : 0;
+    return n;
+  };
+  int cut = 0, below = 0, last = buckets - 1;
+  while (cut < last) {
+    const int middle = (cut + last) / 2;
+    const int n = at_most(middle);
+    if (n >= count) {
+      last = middle;
+    } else {
+      cut = middle + 1;
+      below = n;
+    }
+  }
 
   Moments nearest = sum_moments(nb, 0, k, [&](int j) { return bucket_of[j] < cut ? 1.f : 0.f; });
+  // The straddling bucket's members (a few of k), found eight buckets at a time.
   scratch.straddling.clear();
-  for (int j = 0; j < k; ++j) {
-    if (bucket_of[j] == cut) {
+  for (int word = 0; word < k; word += 8) {
+    for (std::uint64_t matches = bytes_equal_to(bytes_at(bucket_of + word), std::uint8_t(cut));
+         matches != 0; matches &= matches - 1) {
+      const int j = word + std::countr_zero(matches) / 8;
       scratch.straddling.push_back((std::uint64_t(std::bit_cast<std::uint32_t>(d2[j])) << 32) |
                                    std::uint32_t(j));
     }

@@ -29,13 +29,16 @@ bool is_power_of_two(std::size_t n) { return n != 0 && (n & (n - 1)) == 0; }
 // ---- inference kernels; activations are stored feature-major: row r of a batch buffer holds
 // ---- feature r of every point, so the innermost loops run over points and vectorise.
 
-// output rows [0, outputs) = weights * input rows [0, inputs) + bias, for `count` points.
-// Both layer kernels are also compiled for x86-64-v3: eight lanes and fused multiply-adds
-// (logits then differ from the baseline's by float rounding).
+// output rows [0, outputs) = leaky(weights * input rows [0, inputs) + bias), for `count`
+// points; leaky(x) = x > 0 ? x : slope·x, so slope 1 leaves the layer linear. The activation
+// runs on each output row while it is still in cache.
+// Compiled also for x86-64-v3: eight lanes and fused multiply-adds (logits then differ from
+// the baseline's by float rounding).
 #if defined(__x86_64__)
 __attribute__((target_clones("arch=x86-64-v3", "default")))
 #endif
-void apply_dense(const DenseLayer& layer, const float* input, float* output, std::size_t count) {
+void apply_dense(const DenseLayer& layer, const float* input, float* output, std::size_t count,
+                 float slope) {
   for (int o = 0; o < layer.outputs; ++o) {
     float* out = output + static_cast<std::size_t>(o) * kBatch;
     const float bias = layer.bias[o];
@@ -46,16 +49,7 @@ void apply_dense(const DenseLayer& layer, const float* input, float* output, std
       const float* in = input + static_cast<std::size_t>(i) * kBatch;
       for (std::size_t b = 0; b < count; ++b) out[b] += weight * in[b];
     }
-  }
-}
-
-#if defined(__x86_64__)
-__attribute__((target_clones("arch=x86-64-v3", "default")))
-#endif
-void apply_leaky_relu(float* rows, int row_count, std::size_t count, float slope) {
-  for (int r = 0; r < row_count; ++r) {
-    float* row = rows + static_cast<std::size_t>(r) * kBatch;
-    for (std::size_t b = 0; b < count; ++b) row[b] = row[b] > 0.0f ? row[b] : slope * row[b];
+    for (std::size_t b = 0; b < count; ++b) out[b] = out[b] > 0.0f ? out[b] : slope * out[b];
   }
 }
 
@@ -283,19 +277,18 @@ void Model::predict_rows(const float* rows, std::size_t count, float* probabilit
     for (int node = 0; node < vectors / 2; ++node) {
       const DenseLayer& layer = layers[layer_index++];
       float* out = next + static_cast<std::size_t>(node) * layer.outputs * kBatch;
-      apply_dense(layer, current + static_cast<std::size_t>(2 * node) * width * kBatch, out, count);
-      apply_leaky_relu(out, layer.outputs, count, config.leaky_slope);
+      apply_dense(layer, current + static_cast<std::size_t>(2 * node) * width * kBatch, out, count,
+                  config.leaky_slope);
     }
     std::swap(current, next);
   }
   // Head.
   for (int h = 0; h < config.hidden_layers; ++h) {
     const DenseLayer& layer = layers[layer_index++];
-    apply_dense(layer, current, next, count);
-    apply_leaky_relu(next, layer.outputs, count, config.leaky_slope);
+    apply_dense(layer, current, next, count, config.leaky_slope);
     std::swap(current, next);
   }
-  apply_dense(layers[layer_index], current, next, count);
+  apply_dense(layers[layer_index], current, next, count, /*slope=*/1.0f);  // linear logits
 
   // Softmax and argmax per point.
   for (std::size_t b = 0; b < count; ++b) {
