@@ -499,6 +499,10 @@ LabelledCloud sample_shape(const TopoDS_Shape& shape, const SampleParams& params
     throw Error("shape", "", "has no faces to sample");
   Bnd_Box box;
   BRepBndLib::Add(shape, box);
+  // An unbounded face (e.g. a plane without edges) has an open box, which OCCT reports as
+  // ±1e100: deflections and spacings derived from it would mesh nothing.
+  if (box.IsVoid() || box.IsOpen() || box.IsWhole())
+    throw Error("shape", "bounding box", "is empty or unbounded (a face without a boundary)");
   double x0, y0, z0, x1, y1, z1;
   box.Get(x0, y0, z0, x1, y1, z1);
   const Vec low(x0, y0, z0), high(x1, y1, z1);
@@ -526,6 +530,7 @@ LabelledCloud sample_shape(const TopoDS_Shape& shape, const SampleParams& params
   }
 
   const std::size_t n = samples.positions.size();
+  if (n == 0) throw Error("shape", "sampling", "gave no points");
   std::vector<double> sorted = samples.spacing;
   std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
   const double median_spacing = sorted[n / 2];

@@ -2,6 +2,7 @@
 // edges of a box sharp; a cylinder cut open by a plane has a boundary on the cut only.
 #include <gtest/gtest.h>
 
+#include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepFilletAPI_MakeFillet.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
@@ -13,6 +14,7 @@
 
 #include "cad/part.h"
 #include "cad/sample.h"
+#include "core/error.h"
 
 namespace glint::cad {
 namespace {
@@ -124,6 +126,22 @@ TEST(EdgeClasses, SharpBandMatchesTheAnalyticEdgeLength) {
       labelled.description["labels"]["sharp-edge"].get<double>() / edge_length;
   EXPECT_NEAR(measured_per_length / expected_per_length, 1.0, 0.08)
       << measured_per_length << " vs " << expected_per_length;
+}
+
+// A plane without edges has no bounding box (OCCT reports ±1e100): one clear error, not a
+// crash on an empty sample (a generated part with such a face once crashed `edges synth`).
+TEST(EdgeClasses, UnboundedFaceIsRejectedForEverySampling) {
+  const TopoDS_Shape plane = BRepBuilderAPI_MakeFace(gp_Pln(gp::Origin(), gp::DZ())).Shape();
+  for (const Sampling sampling : {Sampling::vertices, Sampling::uniform, Sampling::scan}) {
+    SampleParams params;
+    params.sampling = sampling;
+    try {
+      sample_shape(plane, params);
+      ADD_FAILURE() << "an unbounded face was sampled";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.element(), "bounding box");
+    }
+  }
 }
 
 }  // namespace
