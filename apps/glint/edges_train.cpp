@@ -180,6 +180,11 @@ void register_edges_train(CLI::App& edges) {
   command->add_option("--iterations", options->params.iterations, "Training iterations")
       ->check(kNonNegative)
       ->capture_default_str();
+  command
+      ->add_option("--dropout", options->params.dropout,
+                   "Dropout probability in the classification layers (the thesis: 0.5)")
+      ->check(CLI::Range(0.0, 0.99))
+      ->capture_default_str();
   command->add_option("--batch", options->params.batch_size, "Points per batch")
       ->check(kPositive)
       ->capture_default_str();

@@ -23,12 +23,13 @@ TEST_F(CliTest, SynthTrainClassifyEval) {
   ASSERT_TRUE(fs::exists(path("clouds/manifest.json")));
 
   const CommandResult train =
-      glint("edges train " + path("clouds") + " --iterations 30 --batch 1024 --seed 3 -o " +
-            path("model.json") + " --report " + path("train.json"));
+      glint("edges train " + path("clouds") + " --iterations 30 --batch 1024 --seed 3 " +
+            "--dropout 0.2 -o " + path("model.json") + " --report " + path("train.json"));
   ASSERT_EQ(train.exit_code, 0) << train.output;
   const auto model = nlohmann::json::parse(std::ifstream(path("model.json")));
   EXPECT_EQ(model["parameter_count"], 1595);
   EXPECT_EQ(model["training"]["seed"], 3);
+  EXPECT_EQ(model["training"]["dropout"], 0.2);
 
   std::string first_cloud;
   for (const auto& entry : fs::directory_iterator(path("clouds")))
