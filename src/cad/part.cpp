@@ -109,10 +109,9 @@ Box bounding_box(const TopoDS_Shape& shape) {
 // Whether make(range) runs to its end in a forked child process: the failure ("kernel crashed
 // (signal N)", "timed out") if not, else empty. OpenCASCADE 7.6 crashes on some valid solids (a
 // fillet: SIGSEGV in TopOpeBRepBuild's face builder); the child inherits the kernel's whole
-// state, so it crashes exactly where this process would. Only operations that survive are then
-// run here, whose results stay bit for bit those of the kernel in this process (a shape handed
-// back from the child would not: the binary round trip and the kernel's own process state
-// changed 9 of 40 generated parts slightly). A child that outlives the time limit by
+// state, so it crashes exactly where this process would. Operations that survive then run here,
+// so their results are the kernel's in this process, bit for bit (docs/decisions.md, "Fillets
+// and chamfers tried in a child process first"). A child that outlives the time limit by
 // kChildGrace_s (e.g. stuck on a lock another thread held at the fork) is killed.
 template <class Make>
 std::string kernel_crash(Make& make, double time_limit_s) {
@@ -137,19 +136,16 @@ std::string kernel_crash(Make& make, double time_limit_s) {
   ::close(fds[1]);
   const auto give_up = std::chrono::steady_clock::now() +
                        std::chrono::duration<double>(time_limit_s + kChildGrace_s);
-  bool killed = false;
-  for (;;) {
+  // The pipe reads as ready when the child has exited; poll returning 0 means time is up.
+  int ready = 0;
+  do {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
         give_up - std::chrono::steady_clock::now());
     pollfd hang_up{fds[0], POLLIN, 0};
-    const int ready = left.count() > 0 ? ::poll(&hang_up, 1, int(left.count())) : 0;
-    if (ready < 0 && errno == EINTR) continue;
-    if (ready == 0) {
-      ::kill(pid, SIGKILL);
-      killed = true;
-    }
-    break;  // the pipe closed (the child exited) or the child was killed
-  }
+    ready = left.count() > 0 ? ::poll(&hang_up, 1, int(left.count())) : 0;
+  } while (ready < 0 && errno == EINTR);
+  const bool killed = ready == 0;
+  if (killed) ::kill(pid, SIGKILL);
   ::close(fds[0]);
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {

@@ -501,7 +501,7 @@ LabelledCloud sample_shape(const TopoDS_Shape& shape, const SampleParams& params
   BRepBndLib::Add(shape, box);
   // An unbounded face (e.g. a plane without edges) has an open box, which OCCT reports as
   // ±1e100: deflections and spacings derived from it would mesh nothing.
-  if (box.IsVoid() || box.IsOpen() || box.IsWhole())
+  if (box.IsVoid() || box.IsOpen())
     throw Error("shape", "bounding box", "is empty or unbounded (a face without a boundary)");
   double x0, y0, z0, x1, y1, z1;
   box.Get(x0, y0, z0, x1, y1, z1);

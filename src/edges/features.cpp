@@ -95,7 +95,9 @@ Moments moments_nearest_to(const geometry::Neighbourhood& nb, int k, const Vecto
   constexpr int buckets = Scratch::kBuckets;
   scratch.squared_distances.resize(k);
   // Padded to whole 8-byte words with a value no bucket has (bytes_equal_to reads words).
-  scratch.bucket_of.assign(std::size_t(k + 7) / 8 * 8, std::uint8_t(0xff));
+  const std::size_t padded = std::size_t(k + 7) / 8 * 8;
+  scratch.bucket_of.resize(padded);
+  std::fill(scratch.bucket_of.begin() + k, scratch.bucket_of.end(), std::uint8_t(0xff));
   float* d2 = scratch.squared_distances.data();
   const float cx = float(centre.x()), cy = float(centre.y()), cz = float(centre.z());
   // The largest squared distance as the maximum of its bit patterns (the same order for
