@@ -129,7 +129,7 @@ TEST(EdgeClasses, SharpBandMatchesTheAnalyticEdgeLength) {
 }
 
 // A plane without edges has no bounding box (OCCT reports ±1e100): one clear error, not a
-// crash on an empty sample (a generated part with such a face once crashed `edges synth`).
+// crash on an empty sample (the generator redraws such a part).
 TEST(EdgeClasses, UnboundedFaceIsRejectedForEverySampling) {
   const TopoDS_Shape plane = BRepBuilderAPI_MakeFace(gp_Pln(gp::Origin(), gp::DZ())).Shape();
   for (const Sampling sampling : {Sampling::vertices, Sampling::uniform, Sampling::scan}) {
