@@ -1,5 +1,7 @@
 #include "fusion/block_occupancy.h"
 
+#include <climits>
+
 namespace glint::fusion {
 
 BlockOccupancy::BlockOccupancy(const TsdfVolume& volume) {
@@ -21,12 +23,45 @@ BlockOccupancy::BlockOccupancy(const TsdfVolume& volume) {
   if (size.x() * size.y() * size.z() > kMaxBits) return;  // may_hold() says "maybe" to all
   size_ = size.cast<int>();
   words_.assign((size.x() * size.y() * size.z() + 63) / 64, 0);
+  cells_ = (size_.array() + (kCellSide - 1)) / kCellSide;
+  cell_words_.assign((std::uint64_t(cells_.x()) * cells_.y() * cells_.z() + 63) / 64, 0);
   for (std::size_t i = 0; i < blocks; ++i) {
     const Eigen::Vector3i b = hash.block(int(i)) - low_;
     const std::uint64_t bit =
         (std::uint64_t(b.z()) * size.y() + std::uint64_t(b.y())) * size.x() + std::uint64_t(b.x());
     words_[bit >> 6] |= std::uint64_t{1} << (bit & 63);
+    const Eigen::Vector3i c = b / kCellSide;
+    const std::uint64_t cell_bit =
+        (std::uint64_t(c.z()) * cells_.y() + std::uint64_t(c.y())) * cells_.x() +
+        std::uint64_t(c.x());
+    cell_words_[cell_bit >> 6] |= std::uint64_t{1} << (cell_bit & 63);
   }
+}
+
+void BlockOccupancy::empty_region(int bx, int by, int bz, Eigen::Vector3i& first,
+                                  Eigen::Vector3i& last) const {
+  const Eigen::Vector3i block(bx, by, bz);
+  first = last = block;
+  if (words_.empty()) return;
+  const Eigen::Vector3i high = low_ + size_ - Eigen::Vector3i::Ones();
+  for (int axis = 0; axis < 3; ++axis) {
+    if (block[axis] >= low_[axis] && block[axis] <= high[axis]) continue;
+    first.setConstant(INT_MIN);
+    last.setConstant(INT_MAX);
+    if (block[axis] < low_[axis]) {
+      last[axis] = low_[axis] - 1;
+    } else {
+      first[axis] = high[axis] + 1;
+    }
+    return;
+  }
+  const Eigen::Vector3i c = (block - low_) / kCellSide;
+  const std::uint64_t cell_bit =
+      (std::uint64_t(c.z()) * cells_.y() + std::uint64_t(c.y())) * cells_.x() +
+      std::uint64_t(c.x());
+  if (cell_words_[cell_bit >> 6] >> (cell_bit & 63) & 1) return;
+  first = low_ + c * kCellSide;
+  last = first + Eigen::Vector3i::Constant(kCellSide - 1);
 }
 
 }  // namespace glint::fusion

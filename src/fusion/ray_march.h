@@ -1,11 +1,12 @@
 #pragma once
 // RayMarch: the search along one ray through the TSDF for its first zero crossing, shared by the
 // view ray cast (fusion/raycast.h) and the single rays of shadow and indirect-light queries
-// (reflectance/light_transport.h). Half a block at a time through unallocated space, a few
-// voxels through unobserved ones, 0.8 * |sdf| (at least one voxel) through observed ones,
-// trilinear values within 2 voxels of the surface; the first + to - crossing is located by
-// linear interpolation between the two samples around it; a - sample with no + one just before
-// it is a back face.
+// (fusion/ray_queue.h). Through unallocated space to the end of the region known to
+// hold no block (its block, its empty cell of blocks, or the space outside all of them; a shadow
+// or gather ray crosses metres of it), a few voxels through unobserved ones, 0.8 * |sdf| (at least
+// one voxel) through observed ones, trilinear values within 2 voxels of the surface; the first + to
+// - crossing is located by linear interpolation between the two samples around it; a - sample with
+// no + one just before it is a back face.
 #include <Eigen/Core>
 #include <algorithm>
 #include <limits>
@@ -36,12 +37,11 @@ struct MarchEnd {
 class RayMarch {
  public:
   RayMarch() = default;
-  RayMarch(const Eigen::Vector3f& ray, float t_max, float voxel, float block)
+  RayMarch(const Eigen::Vector3f& ray, float t_max, float voxel)
       : t_max_(t_max),
         voxel_(voxel),
         inverse_length_(1.0f / ray.norm()),
-        voxel_step_(voxel * inverse_length_),
-        block_step_(0.5f * block * inverse_length_) {}
+        voxel_step_(voxel * inverse_length_) {}
 
   void start(float t_min) {
     state_ = State{};
@@ -76,7 +76,8 @@ class RayMarch {
       sample = TsdfSampler::Sample::unobserved;
     if (sample != TsdfSampler::Sample::observed) {
       s.previous_observed = false;
-      s.t += sample == TsdfSampler::Sample::unallocated ? block_step_ : voxel_step_;
+      s.t = sample == TsdfSampler::Sample::unallocated ? past_empty(sampler, origin, ray, p)
+                                                       : s.t + voxel_step_;
       return true;
     }
     if (sdf < 0) {
@@ -98,6 +99,21 @@ class RayMarch {
   const MarchEnd& end() const { return state_.end; }
 
  private:
+  // The t just past the empty region around p (TsdfSampler::empty_box), or infinity where the
+  // ray never leaves it; at least kMinEmptyStep voxels on, so that rounding cannot hold it.
+  float past_empty(const TsdfSampler& sampler, const Eigen::Vector3f& origin,
+                   const Eigen::Vector3f& ray, const Eigen::Vector3f& p) const {
+    Eigen::Vector3f low, high;
+    sampler.empty_box(p, low, high);
+    float exit = std::numeric_limits<float>::infinity();
+    for (int axis = 0; axis < 3; ++axis) {
+      if (ray[axis] > 0) exit = std::min(exit, (high[axis] - origin[axis]) / ray[axis]);
+      if (ray[axis] < 0) exit = std::min(exit, (low[axis] - origin[axis]) / ray[axis]);
+    }
+    return std::max(exit, state_.t) + kMinEmptyStep * voxel_step_;
+  }
+  static constexpr float kMinEmptyStep = 1.0f / 64;
+
   struct State {
     float t = 0;
     // The start of the last stride through unobserved voxels (-1: none), and where voxel steps
@@ -108,22 +124,8 @@ class RayMarch {
     MarchEnd end;
   };
   float t_max_ = -1;
-  float voxel_ = 0, inverse_length_ = 0, voxel_step_ = 0, block_step_ = 0;
+  float voxel_ = 0, inverse_length_ = 0, voxel_step_ = 0;
   State state_;
 };
-
-// The first surface along origin + t * direction for t in [t_min, t_max] (t in units of
-// |direction|): MarchEnd::t > 0 at a + to - crossing, back_face where the ray entered a surface
-// from behind, neither where it met none. `sampler` reads `volume`.
-inline MarchEnd first_surface(TsdfSampler& sampler, const TsdfVolume& volume,
-                              const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
-                              float t_min, float t_max) {
-  RayMarch march(direction, t_max, float(volume.params().voxel_size_m),
-                 float(volume.params().block_size_m()));
-  march.start(t_min);
-  while (march.step(sampler, origin, direction)) {
-  }
-  return march.end();
-}
 
 }  // namespace glint::fusion

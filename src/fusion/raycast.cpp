@@ -125,7 +125,7 @@ class PixelCast {
     x_ = x;
     ray_ = rotation * intrinsics.ray(x, y).cast<float>();
     const float voxel = float(params.voxel_size_m);
-    march_ = RayMarch(ray_, far, voxel, float(params.block_size_m()));
+    march_ = RayMarch(ray_, far, voxel);
     band_start_ = hint - float(params.truncation_at(hint));
     if (hint > 0 && band_start_ > near_) {
       const float lead_start = std::max(band_start_, hint - kHintLead * voxel);

@@ -4,6 +4,7 @@
 // sampler per thread; the volume must not change while it is read.
 #include <Eigen/Core>
 #include <array>
+#include <climits>
 #include <cmath>
 
 #include "fusion/block_index_cache.h"
@@ -69,6 +70,25 @@ class TsdfSampler {
                                at(0, 0, 1) - at(0, 0, -1)) *
                inverse_step;
     return true;
+  }
+
+  // Around a point p whose nearest voxel lies in an unallocated block: the world box [low, high)
+  // that surely holds no allocated block (BlockOccupancy::empty_region; without an occupancy,
+  // the block alone), infinite where it is unbounded. Voxel x covers [x - 1/2, x + 1/2) voxels.
+  void empty_box(const Eigen::Vector3f& p, Eigen::Vector3f& low, Eigen::Vector3f& high) const {
+    const Eigen::Vector3f v = p * inverse_voxel_;
+    const Eigen::Vector3i block(round_to_int(v.x()) >> kBlockShift,
+                                round_to_int(v.y()) >> kBlockShift,
+                                round_to_int(v.z()) >> kBlockShift);
+    Eigen::Vector3i first = block, last = block;
+    if (occupancy_) occupancy_->empty_region(block.x(), block.y(), block.z(), first, last);
+    const float voxel = 1.0f / inverse_voxel_;
+    for (int axis = 0; axis < 3; ++axis) {
+      low[axis] =
+          first[axis] == INT_MIN ? -INFINITY : (float(first[axis]) * kBlockSide - 0.5f) * voxel;
+      high[axis] =
+          last[axis] == INT_MAX ? INFINITY : (float(last[axis] + 1) * kBlockSide - 0.5f) * voxel;
+    }
   }
 
   // Colour of the nearest voxel (call after an observed sample there); black in a volume that

@@ -6,7 +6,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
-#include "fusion/ray_march.h"
+#include "fusion/ray_queue.h"
 #include "reflectance/hemi_image.h"
 
 namespace glint::reflectance {
@@ -20,6 +20,10 @@ std::uint64_t mix(std::uint64_t z) {
 }
 
 float fraction(float x) { return x - std::floor(x); }
+
+// Voxels whose rays are queued and marched together (fusion::RayQueue): enough rays to keep its
+// lanes busy, few enough that the queue stays in L1.
+constexpr std::size_t kVoxelsPerQueue = 16;
 
 // The box of the allocated blocks in metres, and where a ray from inside it leaves it.
 struct WorldBox {
@@ -112,10 +116,10 @@ LightTransport::LightTransport(const LightTransportParams& params, std::size_t v
   indirect_next_ = make_pool<std::uint32_t>(voxel_capacity, "light transport indirect");
 }
 
-LightMask shadow_mask(fusion::TsdfSampler& sampler, const fusion::TsdfVolume& volume,
-                      const std::vector<render::PointLight>& lights, const Eigen::Vector3f& p,
-                      const Eigen::Vector3f& n, float offset_m) {
-  LightMask mask = kAllLights;
+ShadowRays queue_shadow_rays(fusion::RayQueue& queue, const fusion::TsdfVolume& volume,
+                             const std::vector<render::PointLight>& lights,
+                             const Eigen::Vector3f& p, const Eigen::Vector3f& n, float offset_m) {
+  ShadowRays rays{.first = queue.size()};
   const Eigen::Vector3f origin = p + offset_m * n;
   const std::size_t shadowed = std::min(lights.size(), std::size_t(kMaxShadowedLights));
   for (std::size_t l = 0; l < shadowed; ++l) {
@@ -124,11 +128,29 @@ LightMask shadow_mask(fusion::TsdfSampler& sampler, const fusion::TsdfVolume& vo
     const float distance = to_light.norm();
     const float t_max = shadow_ray_end(lights[l], distance, volume);
     if (!(t_max > 0)) continue;
-    const fusion::MarchEnd end =
-        fusion::first_surface(sampler, volume, origin, to_light / distance, 0.0f, t_max);
-    if (end.t > 0 || end.back_face) mask &= ~(LightMask{1} << l);
+    queue.add(origin, to_light / distance, t_max);
+    rays.queued |= LightMask{1} << l;
+  }
+  return rays;
+}
+
+LightMask shadow_mask(const fusion::RayQueue& queue, const ShadowRays& rays) {
+  LightMask mask = kAllLights;
+  int ray = rays.first;
+  for (LightMask queued = rays.queued; queued != 0; queued &= queued - 1, ++ray) {
+    const fusion::MarchEnd& end = queue.end(ray);
+    if (end.t > 0 || end.back_face) mask &= ~(queued & -queued);
   }
   return mask;
+}
+
+LightMask shadow_mask(fusion::RayQueue& queue, const fusion::TsdfVolume& volume,
+                      const std::vector<render::PointLight>& lights, const Eigen::Vector3f& p,
+                      const Eigen::Vector3f& n, float offset_m) {
+  queue.clear();
+  const ShadowRays rays = queue_shadow_rays(queue, volume, lights, p, n, offset_m);
+  queue.march();
+  return shadow_mask(queue, rays);
 }
 
 void LightTransport::update_shadows(const ObservationGrid& grid, const fusion::TsdfVolume& volume,
@@ -140,13 +162,20 @@ void LightTransport::update_shadows(const ObservationGrid& grid, const fusion::T
     if (grid.has_surface(seen.voxel) &&
         (!shadow_cast_[seen.voxel] || (seen.voxel + frame) % params_.shadow_refresh_frames == 0))
       due_.push_back(seen.voxel);
-  parallel_for_chunks(due_.size(), 16, [&](std::size_t begin, std::size_t end) {
-    fusion::TsdfSampler sampler(volume, &occupancy);
-    for (std::size_t i = begin; i < end; ++i) {
-      const int v = due_[i];
-      lit_[v] = shadow_mask(sampler, volume, lights, grid.position(v), grid.normal(v),
-                            params_.ray_offset_m);
-      shadow_cast_[v] = true;
+  parallel_for_chunks(due_.size(), kVoxelsPerQueue, [&](std::size_t begin, std::size_t end) {
+    fusion::RayQueue queue(volume, &occupancy);
+    std::array<ShadowRays, kVoxelsPerQueue> rays;
+    for (std::size_t batch = begin; batch < end; batch += kVoxelsPerQueue) {
+      const std::size_t batch_end = std::min(end, batch + kVoxelsPerQueue);
+      queue.clear();
+      for (std::size_t i = batch; i < batch_end; ++i)
+        rays[i - batch] = queue_shadow_rays(queue, volume, lights, grid.position(due_[i]),
+                                            grid.normal(due_[i]), params_.ray_offset_m);
+      queue.march();
+      for (std::size_t i = batch; i < batch_end; ++i) {
+        lit_[due_[i]] = shadow_mask(queue, rays[i - batch]);
+        shadow_cast_[due_[i]] = true;
+      }
     }
   });
 }
@@ -170,46 +199,62 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
   // [0, 1)^2 for any number of points, so a voxel's directions stratify however many it has
   // been given; each voxel's sequence is shifted (Cranley-Patterson) by a hash of its place.
   constexpr float kR2a = 0.75487766624669276f, kR2b = 0.56984029099805327f;
-  parallel_for_chunks(due_.size(), 16, [&](std::size_t begin, std::size_t end) {
-    fusion::TsdfSampler sampler(volume, &occupancy);
+  parallel_for_chunks(due_.size(), kVoxelsPerQueue, [&](std::size_t begin, std::size_t end) {
+    fusion::RayQueue queue(volume, &occupancy);
     ObservationGrid::BlockCache blocks;
-    for (std::size_t i = begin; i < end; ++i) {
-      const int v = due_[i];
-      const Eigen::Vector3f& normal = grid.normal(v);
-      const Eigen::Matrix3f to_world = local_frame(normal).transpose();
-      const Eigen::Vector3f origin = grid.position(v) + params_.ray_offset_m * normal;
-      const Eigen::Vector3i place = grid.voxel_coordinates(v);
-      const std::uint64_t hash =
-          mix(params_.seed ^ mix(std::uint64_t(std::uint32_t(place.x())) ^
-                                 std::uint64_t(std::uint32_t(place.y())) << 21 ^
-                                 std::uint64_t(std::uint32_t(place.z())) << 42));
-      const float shift_a = float(hash >> 40) * 0x1p-24f;
-      const float shift_b = float((hash >> 16) & 0xFFFFFF) * 0x1p-24f;
-      const int rays = indirect_rays_[v] < n ? params_.indirect_rays_per_frame : 1;
-      for (int k = 0; k < rays; ++k) {
-        const float index = float(indirect_next_[v]++ % (1u << 22));
-        const float u1 = fraction(shift_a + index * kR2a), u2 = fraction(shift_b + index * kR2b);
-        const float radius = std::sqrt(u1), phi = 2 * float(M_PI) * u2;
-        const Eigen::Vector3f direction =
-            to_world * Eigen::Vector3f(radius * std::cos(phi), radius * std::sin(phi),
-                                       std::sqrt(std::max(0.0f, 1 - u1)));
-        const float t_max = std::min(params_.indirect_max_distance_m, box.exit(origin, direction));
-        const fusion::MarchEnd hit =
-            fusion::first_surface(sampler, volume, origin, direction, 0.0f, t_max);
-        if (hit.back_face) continue;                         // unknown radiance: not counted
-        Eigen::Vector3f radiance = Eigen::Vector3f::Zero();  // none beyond the reconstruction
-        if (hit.t > 0) {
-          const Eigen::Vector3f h = origin + direction * hit.t;
-          if (!on_light(lights, h, margin) && !hit_radiance(grid, h, direction, blocks, radiance))
-            continue;
-          if (!(radiance.maxCoeff() < params_.saturated_radiance))
-            radiance = Eigen::Vector3f::Zero();
+    std::array<int, kVoxelsPerQueue> ray_count;
+    for (std::size_t batch = begin; batch < end; batch += kVoxelsPerQueue) {
+      const std::size_t batch_end = std::min(end, batch + kVoxelsPerQueue);
+      queue.clear();
+      for (std::size_t i = batch; i < batch_end; ++i) {
+        const int v = due_[i];
+        const Eigen::Vector3f& normal = grid.normal(v);
+        const Eigen::Matrix3f to_world = local_frame(normal).transpose();
+        const Eigen::Vector3f origin = grid.position(v) + params_.ray_offset_m * normal;
+        const Eigen::Vector3i place = grid.voxel_coordinates(v);
+        const std::uint64_t hash =
+            mix(params_.seed ^ mix(std::uint64_t(std::uint32_t(place.x())) ^
+                                   std::uint64_t(std::uint32_t(place.y())) << 21 ^
+                                   std::uint64_t(std::uint32_t(place.z())) << 42));
+        const float shift_a = float(hash >> 40) * 0x1p-24f;
+        const float shift_b = float((hash >> 16) & 0xFFFFFF) * 0x1p-24f;
+        const int rays = indirect_rays_[v] < n ? params_.indirect_rays_per_frame : 1;
+        ray_count[i - batch] = rays;
+        for (int k = 0; k < rays; ++k) {
+          const float index = float(indirect_next_[v]++ % (1u << 22));
+          const float u1 = fraction(shift_a + index * kR2a), u2 = fraction(shift_b + index * kR2b);
+          const float radius = std::sqrt(u1), phi = 2 * float(M_PI) * u2;
+          const Eigen::Vector3f direction =
+              to_world * Eigen::Vector3f(radius * std::cos(phi), radius * std::sin(phi),
+                                         std::sqrt(std::max(0.0f, 1 - u1)));
+          queue.add(origin, direction,
+                    std::min(params_.indirect_max_distance_m, box.exit(origin, direction)));
         }
-        if (indirect_rays_[v] < n) {
-          indirect_sum_[v] += radiance;
-          ++indirect_rays_[v];
-        } else {  // a moving average over the latest n
-          indirect_sum_[v] += radiance - indirect_sum_[v] / float(n);
+      }
+      queue.march();
+      // The rays in the order they were queued: each voxel's sum adds them in its sequence's
+      // order.
+      int ray = 0;
+      for (std::size_t i = batch; i < batch_end; ++i) {
+        const int v = due_[i];
+        for (int k = 0; k < ray_count[i - batch]; ++k, ++ray) {
+          const fusion::MarchEnd& hit = queue.end(ray);
+          if (hit.back_face) continue;                         // unknown radiance: not counted
+          Eigen::Vector3f radiance = Eigen::Vector3f::Zero();  // none beyond the reconstruction
+          if (hit.t > 0) {
+            const Eigen::Vector3f& direction = queue.direction(ray);
+            const Eigen::Vector3f h = queue.origin(ray) + direction * hit.t;
+            if (!on_light(lights, h, margin) && !hit_radiance(grid, h, direction, blocks, radiance))
+              continue;
+            if (!(radiance.maxCoeff() < params_.saturated_radiance))
+              radiance = Eigen::Vector3f::Zero();
+          }
+          if (indirect_rays_[v] < n) {
+            indirect_sum_[v] += radiance;
+            ++indirect_rays_[v];
+          } else {  // a moving average over the latest n
+            indirect_sum_[v] += radiance - indirect_sum_[v] / float(n);
+          }
         }
       }
     }
@@ -219,8 +264,7 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
 PointLighting PointLightingQuery::operator()(const Eigen::Vector3f& p, const Eigen::Vector3f& n) {
   PointLighting result;
   const LightTransportParams& params = transport_.params();
-  if (params.shadows)
-    result.lit = shadow_mask(sampler_, volume_, lights_, p, n, params.ray_offset_m);
+  if (params.shadows) result.lit = shadow_mask(rays_, volume_, lights_, p, n, params.ray_offset_m);
   if (params.indirect)
     if (const int v = grid_.find(p, &blocks_); v >= 0)
       result.indirect = transport_.lighting(v).indirect;

@@ -25,7 +25,7 @@
 
 #include "core/pool_memory.h"
 #include "fusion/block_occupancy.h"
-#include "fusion/tsdf_sampler.h"
+#include "fusion/ray_queue.h"
 #include "fusion/tsdf_volume.h"
 #include "reflectance/light_incidence.h"
 #include "reflectance/observation_grid.h"
@@ -102,10 +102,22 @@ class LightTransport {
   std::vector<int> due_;                     // scratch: the voxels due in a frame
 };
 
-// The lights that reach surface point p (unit normal n) through `volume`: one shadow ray per
-// light from p + offset_m * n, ending short of the light's proxy sphere (the lamp itself is in
-// the fused depth of a synthetic sequence).
-LightMask shadow_mask(fusion::TsdfSampler& sampler, const fusion::TsdfVolume& volume,
+// Surface point p's shadow rays (unit normal n): one per light in front of it, from
+// p + offset_m * n, ending short of the light's proxy sphere (the lamp itself is in the fused
+// depth of a synthetic sequence). Queued in light order from ray `first`; `queued` holds their
+// lights.
+struct ShadowRays {
+  int first = 0;
+  LightMask queued = 0;
+};
+ShadowRays queue_shadow_rays(fusion::RayQueue& queue, const fusion::TsdfVolume& volume,
+                             const std::vector<render::PointLight>& lights,
+                             const Eigen::Vector3f& p, const Eigen::Vector3f& n, float offset_m);
+// The lights that reach the point once `queue` has marched its rays: those not queued (behind
+// the surface, or beyond kMaxShadowedLights) and those whose ray met no surface.
+LightMask shadow_mask(const fusion::RayQueue& queue, const ShadowRays& rays);
+// Both for one point (the queue is cleared first).
+LightMask shadow_mask(fusion::RayQueue& queue, const fusion::TsdfVolume& volume,
                       const std::vector<render::PointLight>& lights, const Eigen::Vector3f& p,
                       const Eigen::Vector3f& n, float offset_m);
 
@@ -120,7 +132,7 @@ class PointLightingQuery {
         grid_(grid),
         volume_(volume),
         lights_(lights),
-        sampler_(volume, &occupancy) {}
+        rays_(volume, &occupancy) {}
   PointLighting operator()(const Eigen::Vector3f& p, const Eigen::Vector3f& n);
 
  private:
@@ -128,7 +140,7 @@ class PointLightingQuery {
   const ObservationGrid& grid_;
   const fusion::TsdfVolume& volume_;
   const std::vector<render::PointLight>& lights_;
-  fusion::TsdfSampler sampler_;
+  fusion::RayQueue rays_;
   ObservationGrid::BlockCache blocks_;
 };
 

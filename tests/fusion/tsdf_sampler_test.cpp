@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <climits>
 #include <cstdint>
 #include <vector>
 
@@ -140,6 +141,39 @@ TEST(TsdfVolume, DistanceLinesAreTheLinesHoldingTheRowsOfTheSlices) {
           EXPECT_EQ(TsdfVolume::distance_lines(y0, y1, z0, z1), expected)
               << "rows " << y0 << ".." << y1 << ", slices " << z0 << ".." << z1;
         }
+}
+
+TEST(BlockOccupancy, EmptyRegionsHoldNoAllocatedBlock) {
+  TsdfVolume volume(centimetre_voxels());
+  const std::vector<Eigen::Vector3i> allocated = {{-9, 0, 2}, {4, -1, 2}, {0, 5, -6}, {1, 1, 1}};
+  for (const Eigen::Vector3i& b : allocated) ASSERT_GE(volume.allocate(b), 0);
+  const BlockOccupancy occupancy(volume);
+  int whole_cells = 0, slabs = 0;
+  for (int z = -12; z <= 12; ++z)
+    for (int y = -12; y <= 12; ++y)
+      for (int x = -12; x <= 12; ++x) {
+        if (occupancy.may_hold(x, y, z)) continue;
+        Eigen::Vector3i first, last;
+        occupancy.empty_region(x, y, z, first, last);
+        const Eigen::Vector3i block(x, y, z);
+        ASSERT_TRUE((first.array() <= block.array()).all() && (block.array() <= last.array()).all())
+            << x << " " << y << " " << z;
+        for (const Eigen::Vector3i& b : allocated)
+          ASSERT_FALSE((first.array() <= b.array()).all() && (b.array() <= last.array()).all())
+              << "the region of " << x << " " << y << " " << z << " holds " << b.transpose();
+        const bool unbounded = (first.array() == INT_MIN).any() || (last.array() == INT_MAX).any();
+        slabs += unbounded;
+        whole_cells += !unbounded && last != first;
+      }
+  EXPECT_GT(whole_cells, 100);  // 4^3-block cells between the blocks
+  EXPECT_GT(slabs, 1000);       // around the box of the blocks
+
+  // Without a bit array (an empty volume's), only the block itself.
+  TsdfVolume none(centimetre_voxels());
+  Eigen::Vector3i first, last;
+  BlockOccupancy(none).empty_region(3, 4, 5, first, last);
+  EXPECT_EQ(first, Eigen::Vector3i(3, 4, 5));
+  EXPECT_EQ(last, Eigen::Vector3i(3, 4, 5));
 }
 
 TEST(BlockOccupancy, HoldsEveryAllocatedBlockAndRulesOutTheRest) {

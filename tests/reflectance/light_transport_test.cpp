@@ -160,11 +160,11 @@ TEST(LightTransport, AVoxelBehindAnOccluderGetsNoLightFromThatLight) {
   EXPECT_EQ(off.lighting(scene.grid().visible().front().voxel).lit, kAllLights);
 
   // A point on the wall's open part lit by both, and the shadowed centre, queried directly.
-  fusion::TsdfSampler sampler(scene.geometry(), &occupancy);
+  fusion::RayQueue queue(scene.geometry(), &occupancy);
   const Eigen::Vector3f facing(0, 0, -1);
-  EXPECT_EQ(shadow_mask(sampler, scene.geometry(), lights, {0.5f, 0.5f, 1.0f}, facing, 0.01f),
+  EXPECT_EQ(shadow_mask(queue, scene.geometry(), lights, {0.5f, 0.5f, 1.0f}, facing, 0.01f),
             kAllLights);
-  EXPECT_EQ(shadow_mask(sampler, scene.geometry(), lights, {0, 0, 1}, facing, 0.01f),
+  EXPECT_EQ(shadow_mask(queue, scene.geometry(), lights, {0, 0, 1}, facing, 0.01f),
             kAllLights & ~LightMask{1});
 }
 
