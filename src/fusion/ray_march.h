@@ -1,12 +1,12 @@
 #pragma once
 // RayMarch: the search along one ray through the TSDF for its first zero crossing, shared by the
 // view ray cast (fusion/raycast.h) and the single rays of shadow and indirect-light queries
-// (fusion/ray_queue.h). Through unallocated space to the end of the region known to
-// hold no block (its block, its empty cell of blocks, or the space outside all of them; a shadow
-// or gather ray crosses metres of it), a few voxels through unobserved ones, 0.8 * |sdf| (at least
-// one voxel) through observed ones, trilinear values within 2 voxels of the surface; the first + to
-// - crossing is located by linear interpolation between the two samples around it; a - sample with
-// no + one just before it is a back face.
+// (fusion/ray_queue.h). Through unallocated space to the end of the region known to hold no
+// block (its block, its empty cell of blocks, or the space outside all of them: a shadow or
+// gather ray crosses metres of it), a few voxels through unobserved ones, 0.8 * |sdf| (at least
+// one voxel) through observed ones, trilinear values within 2 voxels of the surface. The first
+// crossing from + to - is located by linear interpolation between the two samples around it; a
+// negative sample with no positive one just before it is a back face.
 #include <Eigen/Core>
 #include <algorithm>
 #include <limits>
