@@ -88,6 +88,55 @@ float shadow_ray_end(const render::PointLight& light, float distance,
   return distance - float(light.proxy_radius_m) - 2 * float(volume.params().voxel_size_m);
 }
 
+// Queues voxel v's next `rays` gather rays: cosine-weighted directions from its sequence, whose
+// index `next` advances. The sequence is the additive recurrence of the plastic number (Roberts'
+// R2): low-discrepancy in [0, 1)^2 for any number of points, so a voxel's directions stratify
+// however many it has been given; each voxel's sequence is shifted (Cranley-Patterson) by a hash
+// of its place.
+void queue_gather_rays(const ObservationGrid& grid, int v, int rays,
+                       const LightTransportParams& params, const WorldBox& box, std::uint32_t& next,
+                       fusion::RayQueue& queue) {
+  constexpr float kR2a = 0.75487766624669276f, kR2b = 0.56984029099805327f;
+  const Eigen::Vector3f& normal = grid.normal(v);
+  const Eigen::Matrix3f to_world = local_frame(normal).transpose();
+  const Eigen::Vector3f origin = grid.position(v) + params.ray_offset_m * normal;
+  const Eigen::Vector3i place = grid.voxel_coordinates(v);
+  const std::uint64_t hash = mix(params.seed ^ mix(std::uint64_t(std::uint32_t(place.x())) ^
+                                                   std::uint64_t(std::uint32_t(place.y())) << 21 ^
+                                                   std::uint64_t(std::uint32_t(place.z())) << 42));
+  const float shift_a = float(hash >> 40) * 0x1p-24f;
+  const float shift_b = float((hash >> 16) & 0xFFFFFF) * 0x1p-24f;
+  for (int k = 0; k < rays; ++k) {
+    const float index = float(next++ % (1u << 22));
+    const float u1 = fraction(shift_a + index * kR2a), u2 = fraction(shift_b + index * kR2b);
+    const float radius = std::sqrt(u1), phi = 2 * float(M_PI) * u2;
+    const Eigen::Vector3f direction =
+        to_world * Eigen::Vector3f(radius * std::cos(phi), radius * std::sin(phi),
+                                   std::sqrt(std::max(0.0f, 1 - u1)));
+    queue.add(origin, direction,
+              std::min(params.indirect_max_distance_m, box.exit(origin, direction)));
+  }
+}
+
+// The radiance marched gather ray `ray` brings: none where it left the reconstruction or met a
+// light's proxy or a clipped surface (their light is direct); false where it is unknown (a back
+// face, a surface never observed), which is not counted.
+bool gathered_radiance(const fusion::RayQueue& queue, int ray, const ObservationGrid& grid,
+                       const std::vector<render::PointLight>& lights, float margin,
+                       float saturated_radiance, ObservationGrid::BlockCache& blocks,
+                       Eigen::Vector3f& radiance) {
+  const fusion::MarchEnd& hit = queue.end(ray);
+  if (hit.back_face) return false;
+  radiance = Eigen::Vector3f::Zero();
+  if (!(hit.t > 0)) return true;
+  const Eigen::Vector3f& direction = queue.direction(ray);
+  const Eigen::Vector3f h = queue.origin(ray) + direction * hit.t;
+  if (!on_light(lights, h, margin) && !hit_radiance(grid, h, direction, blocks, radiance))
+    return false;
+  if (!(radiance.maxCoeff() < saturated_radiance)) radiance = Eigen::Vector3f::Zero();
+  return true;
+}
+
 }  // namespace
 
 LightTransport::LightTransport(const LightTransportParams& params, std::size_t voxel_capacity)
@@ -195,10 +244,6 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
   const WorldBox box(occupancy, volume);
   // A hit this close to a light's proxy lies on it, or in an observation voxel it shares.
   const float margin = 2 * float(grid.params().voxel_size_m);
-  // The additive recurrence of the plastic number (Roberts' R2 sequence): low-discrepancy in
-  // [0, 1)^2 for any number of points, so a voxel's directions stratify however many it has
-  // been given; each voxel's sequence is shifted (Cranley-Patterson) by a hash of its place.
-  constexpr float kR2a = 0.75487766624669276f, kR2b = 0.56984029099805327f;
   parallel_for_chunks(due_.size(), kVoxelsPerQueue, [&](std::size_t begin, std::size_t end) {
     fusion::RayQueue queue(volume, &occupancy);
     ObservationGrid::BlockCache blocks;
@@ -208,28 +253,8 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
       queue.clear();
       for (std::size_t i = batch; i < batch_end; ++i) {
         const int v = due_[i];
-        const Eigen::Vector3f& normal = grid.normal(v);
-        const Eigen::Matrix3f to_world = local_frame(normal).transpose();
-        const Eigen::Vector3f origin = grid.position(v) + params_.ray_offset_m * normal;
-        const Eigen::Vector3i place = grid.voxel_coordinates(v);
-        const std::uint64_t hash =
-            mix(params_.seed ^ mix(std::uint64_t(std::uint32_t(place.x())) ^
-                                   std::uint64_t(std::uint32_t(place.y())) << 21 ^
-                                   std::uint64_t(std::uint32_t(place.z())) << 42));
-        const float shift_a = float(hash >> 40) * 0x1p-24f;
-        const float shift_b = float((hash >> 16) & 0xFFFFFF) * 0x1p-24f;
-        const int rays = indirect_rays_[v] < n ? params_.indirect_rays_per_frame : 1;
-        ray_count[i - batch] = rays;
-        for (int k = 0; k < rays; ++k) {
-          const float index = float(indirect_next_[v]++ % (1u << 22));
-          const float u1 = fraction(shift_a + index * kR2a), u2 = fraction(shift_b + index * kR2b);
-          const float radius = std::sqrt(u1), phi = 2 * float(M_PI) * u2;
-          const Eigen::Vector3f direction =
-              to_world * Eigen::Vector3f(radius * std::cos(phi), radius * std::sin(phi),
-                                         std::sqrt(std::max(0.0f, 1 - u1)));
-          queue.add(origin, direction,
-                    std::min(params_.indirect_max_distance_m, box.exit(origin, direction)));
-        }
+        ray_count[i - batch] = indirect_rays_[v] < n ? params_.indirect_rays_per_frame : 1;
+        queue_gather_rays(grid, v, ray_count[i - batch], params_, box, indirect_next_[v], queue);
       }
       queue.march();
       // The rays in the order they were queued: each voxel's sum adds them in its sequence's
@@ -238,17 +263,10 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
       for (std::size_t i = batch; i < batch_end; ++i) {
         const int v = due_[i];
         for (int k = 0; k < ray_count[i - batch]; ++k, ++ray) {
-          const fusion::MarchEnd& hit = queue.end(ray);
-          if (hit.back_face) continue;                         // unknown radiance: not counted
-          Eigen::Vector3f radiance = Eigen::Vector3f::Zero();  // none beyond the reconstruction
-          if (hit.t > 0) {
-            const Eigen::Vector3f& direction = queue.direction(ray);
-            const Eigen::Vector3f h = queue.origin(ray) + direction * hit.t;
-            if (!on_light(lights, h, margin) && !hit_radiance(grid, h, direction, blocks, radiance))
-              continue;
-            if (!(radiance.maxCoeff() < params_.saturated_radiance))
-              radiance = Eigen::Vector3f::Zero();
-          }
+          Eigen::Vector3f radiance;
+          if (!gathered_radiance(queue, ray, grid, lights, margin, params_.saturated_radiance,
+                                 blocks, radiance))
+            continue;
           if (indirect_rays_[v] < n) {
             indirect_sum_[v] += radiance;
             ++indirect_rays_[v];
