@@ -2,10 +2,11 @@
 // Ray casting of the TSDF's zero crossing for one camera view (VoxelHashing §5; KinectFusion
 // §3.4): the model view that tracking aligns the next frame to, and a rendering of the model.
 // Rays march through the depth interval that allocated blocks cover in their 4x4-pixel tile
-// (within depth_min_m..depth_max_m of the volume parameters): half a block at a time
-// through unallocated space, one voxel through unobserved voxels, 0.8 * |sdf| (at least one
-// voxel) through observed ones, reading trilinear values within 2 voxels of the surface; the
-// first + to - crossing is located by linear interpolation between the two samples around it.
+// (within depth_min_m..depth_max_m of the volume parameters), as fusion/ray_march.h steps:
+// across unallocated space to the end of the region known to be empty, strides through
+// unobserved voxels, 0.8 * |sdf| (at least one voxel) through observed ones, reading trilinear
+// values within 2 voxels of the surface; the first + to - crossing is located by linear
+// interpolation between the two samples around it.
 // Back faces (- first) end the ray without a hit. With a depth hint (below), a ray first marches
 // from just in front of the hinted depth.
 #include "core/camera.h"
