@@ -30,11 +30,8 @@ BlockOccupancy::BlockOccupancy(const TsdfVolume& volume) {
     const std::uint64_t bit =
         (std::uint64_t(b.z()) * size.y() + std::uint64_t(b.y())) * size.x() + std::uint64_t(b.x());
     words_[bit >> 6] |= std::uint64_t{1} << (bit & 63);
-    const Eigen::Vector3i c = b / kCellSide;
-    const std::uint64_t cell_bit =
-        (std::uint64_t(c.z()) * cells_.y() + std::uint64_t(c.y())) * cells_.x() +
-        std::uint64_t(c.x());
-    cell_words_[cell_bit >> 6] |= std::uint64_t{1} << (cell_bit & 63);
+    const std::uint64_t cell = cell_bit(b / kCellSide);
+    cell_words_[cell >> 6] |= std::uint64_t{1} << (cell & 63);
   }
 }
 
@@ -56,10 +53,8 @@ void BlockOccupancy::empty_region(int bx, int by, int bz, Eigen::Vector3i& first
     return;
   }
   const Eigen::Vector3i c = (block - low_) / kCellSide;
-  const std::uint64_t cell_bit =
-      (std::uint64_t(c.z()) * cells_.y() + std::uint64_t(c.y())) * cells_.x() +
-      std::uint64_t(c.x());
-  if (cell_words_[cell_bit >> 6] >> (cell_bit & 63) & 1) return;
+  const std::uint64_t cell = cell_bit(c);
+  if (cell_words_[cell >> 6] >> (cell & 63) & 1) return;
   first = low_ + c * kCellSide;
   last = first + Eigen::Vector3i::Constant(kCellSide - 1);
 }

@@ -53,6 +53,13 @@ class BlockOccupancy {
   }
 
  private:
+  // The bit of cell c (cell coordinates from low_) in cell_words_.
+  std::uint64_t cell_bit(const Eigen::Vector3i& c) const {
+    return (std::uint64_t(c.z()) * std::uint64_t(cells_.y()) + std::uint64_t(c.y())) *
+               std::uint64_t(cells_.x()) +
+           std::uint64_t(c.x());
+  }
+
   Eigen::Vector3i low_ = Eigen::Vector3i::Zero(), size_ = Eigen::Vector3i::Zero();
   std::vector<std::uint64_t> words_;
   Eigen::Vector3i cells_ = Eigen::Vector3i::Zero();  // cells per axis over the box

@@ -15,6 +15,18 @@
 
 namespace glint::fusion {
 
+// The t at which origin + t * ray, inside the box [low, high], leaves it: the nearest of the
+// faces ahead of it along each axis; infinity where it never does (bounds may be infinite).
+inline float box_exit(const Eigen::Vector3f& origin, const Eigen::Vector3f& ray,
+                      const Eigen::Vector3f& low, const Eigen::Vector3f& high) {
+  float exit = std::numeric_limits<float>::infinity();
+  for (int axis = 0; axis < 3; ++axis) {
+    if (ray[axis] > 0) exit = std::min(exit, (high[axis] - origin[axis]) / ray[axis]);
+    if (ray[axis] < 0) exit = std::min(exit, (low[axis] - origin[axis]) / ray[axis]);
+  }
+  return exit;
+}
+
 // Voxels a ray skips per step through unobserved voxels of allocated blocks (space behind
 // surfaces, or beside them, that no frame saw). Landing on observed space after such a stride,
 // it steps back and crosses the stride again voxel by voxel, so only an observed stretch
@@ -105,12 +117,7 @@ class RayMarch {
                    const Eigen::Vector3f& ray, const Eigen::Vector3f& p) const {
     Eigen::Vector3f low, high;
     sampler.empty_box(p, low, high);
-    float exit = std::numeric_limits<float>::infinity();
-    for (int axis = 0; axis < 3; ++axis) {
-      if (ray[axis] > 0) exit = std::min(exit, (high[axis] - origin[axis]) / ray[axis]);
-      if (ray[axis] < 0) exit = std::min(exit, (low[axis] - origin[axis]) / ray[axis]);
-    }
-    return std::max(exit, state_.t) + kMinEmptyStep * voxel_step_;
+    return std::max(box_exit(origin, ray, low, high), state_.t) + kMinEmptyStep * voxel_step_;
   }
   static constexpr float kMinEmptyStep = 1.0f / 64;
 

@@ -1,11 +1,10 @@
 #pragma once
 // RayQueue: the first surfaces of many single rays through the TSDF (the shadow and gather rays
 // of reflectance/light_transport.h), marched kLanes at a time in turn. A march is a chain of
-// dependent loads, and in a volume of many blocks most of them miss the caches: one ray at a
-// time spent over a quarter of its time waiting on one load; interleaved, the misses overlap
-// (as the view ray cast does, fusion/raycast.cpp). Each lane has its own block cache, since
-// the rays of a queue diverge (a point's shadow rays to different lights). One per thread;
-// reused, it keeps its memory.
+// dependent loads, and in a volume of many blocks most of them miss the caches; interleaved, the
+// misses of different rays overlap (as in the view ray cast, fusion/raycast.cpp). Each lane has
+// its own block cache, since the rays of a queue diverge (a point's shadow rays to different
+// lights). One per thread; reused, it keeps its memory.
 #include <Eigen/Core>
 #include <array>
 #include <vector>

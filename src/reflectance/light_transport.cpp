@@ -38,13 +38,7 @@ struct WorldBox {
     known = true;
   }
   float exit(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction) const {
-    float t = INFINITY;
-    if (!known) return t;
-    for (int axis = 0; axis < 3; ++axis) {
-      if (direction[axis] > 0) t = std::min(t, (high[axis] - origin[axis]) / direction[axis]);
-      if (direction[axis] < 0) t = std::min(t, (low[axis] - origin[axis]) / direction[axis]);
-    }
-    return std::max(t, 0.0f);
+    return known ? std::max(fusion::box_exit(origin, direction, low, high), 0.0f) : INFINITY;
   }
 };
 
