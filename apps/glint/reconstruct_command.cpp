@@ -253,6 +253,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"exposure", options.params.exposure},
          {"shadows", options.params.light_transport.shadows},
          {"indirect", options.params.light_transport.indirect},
+         {"unseen_light", options.params.light_transport.unseen},
          {"indirect_rays", options.params.light_transport.indirect_rays},
          {"indirect_rays_per_frame", options.params.light_transport.indirect_rays_per_frame},
          {"ray_offset_m", options.params.light_transport.ray_offset_m},
@@ -478,6 +479,18 @@ void register_reconstruct_command(CLI::App& app) {
           "reflectance hemi-images divide by (off = direct light only, as the paper)")
       ->check(CLI::IsMember({"on", "off"}))
       ->default_str(transport.indirect ? "on" : "off");
+  command
+      ->add_option_function<std::string>(
+          "--unseen-light",
+          [options](const std::string& value) {
+            options->params.light_transport.unseen = value == "on";
+          },
+          "Per segment, the indirect irradiance that shadows and the gather leave unexplained "
+          "(light bounced off surfaces the camera never saw; all of it with --indirect off), "
+          "fitted from how the segment's diffuse radiance grows with the irradiance it is known "
+          "to get, and added to its voxels' (off = none)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->default_str(transport.unseen ? "on" : "off");
   command
       ->add_option("--indirect-rays", transport.indirect_rays,
                    "Cosine-weighted gather rays per voxel in its indirect estimate (afterwards a "

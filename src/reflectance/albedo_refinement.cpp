@@ -135,13 +135,13 @@ AlbedoAverage parse_albedo_average(const std::string& name) {
   throw Error("albedo average", name, "must be mean or median");
 }
 
-std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int count,
-                                           const Eigen::Vector3f& position,
-                                           const Eigen::Vector3f& normal,
-                                           const std::vector<render::PointLight>& lights,
-                                           const Eigen::Vector3f& ks, float alpha,
-                                           AlbedoAverage average, float saturated_radiance,
-                                           const PointLighting& lighting) {
+std::optional<DiffuseObservation> observe_diffuse(const Observation* observations, int count,
+                                                  const Eigen::Vector3f& position,
+                                                  const Eigen::Vector3f& normal,
+                                                  const std::vector<render::PointLight>& lights,
+                                                  const Eigen::Vector3f& ks, float alpha,
+                                                  AlbedoAverage average, float saturated_radiance,
+                                                  const PointLighting& lighting) {
   // The observations seen from above the surface: their colours, and their directions as
   // arrays, for the batched lobe.
   std::array<Eigen::Vector3f, kMaxObservationsPerVoxel> colour;
@@ -186,26 +186,50 @@ std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int 
                                 lobe.data());
     for (int j = 0; j < used; ++j) specular[j] += in.irradiance * lobe[j];
   }
-  if (diffuse.minCoeff() <= 1e-12f) return std::nullopt;
-
-  // Eq. (7) per observation and channel.
-  RefinedAlbedo refined;
-  refined.light_tangent = sines / cosines;
-  refined.indirect_share = lighting.indirect.mean() / cosines;
-  refined.lower_bound = only_clipped;
+  // Each observation's radiance less its specular term, per channel.
+  DiffuseObservation observed{.irradiance = diffuse,
+                              .cosines = cosines,
+                              .sines = sines,
+                              .indirect = lighting.indirect.mean(),
+                              .lower_bound = only_clipped};
   std::array<Channels, std::max(kMaxObservationsPerVoxel, kNetworkSize)> values;
   for (int j = 0; j < used; ++j) {
     values[j] = Channels{};
-    for (int c = 0; c < 3; ++c)
-      values[j][c] = float(M_PI) * (colour[j][c] - ks[c] * specular[j][c]) / diffuse[c];
+    for (int c = 0; c < 3; ++c) values[j][c] = colour[j][c] - ks[c] * specular[j][c];
   }
   if (average == AlbedoAverage::median) {
-    refined.kd = channel_medians(values.data(), used);
+    observed.radiance = channel_medians(values.data(), used);
   } else {
     const Channels sum = std::accumulate(values.begin(), values.begin() + used, Channels{});
-    refined.kd = Eigen::Vector3f(sum[0], sum[1], sum[2]) / float(used);
+    observed.radiance = Eigen::Vector3f(sum[0], sum[1], sum[2]) / float(used);
   }
+  return observed;
+}
+
+std::optional<RefinedAlbedo> solve_albedo(const DiffuseObservation& observed,
+                                          const Eigen::Vector3f& unseen) {
+  const Eigen::Vector3f irradiance = observed.irradiance + unseen;
+  if (irradiance.minCoeff() <= 1e-12f) return std::nullopt;
+  const float cosines = observed.cosines + unseen.mean();
+  RefinedAlbedo refined;
+  refined.kd = float(M_PI) * observed.radiance.cwiseQuotient(irradiance);  // eq. (7)
+  refined.light_tangent = observed.sines / cosines;
+  refined.indirect_share = observed.indirect / cosines;
+  refined.lower_bound = observed.lower_bound;
   return refined;
+}
+
+std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int count,
+                                           const Eigen::Vector3f& position,
+                                           const Eigen::Vector3f& normal,
+                                           const std::vector<render::PointLight>& lights,
+                                           const Eigen::Vector3f& ks, float alpha,
+                                           AlbedoAverage average, float saturated_radiance,
+                                           const PointLighting& lighting) {
+  const auto observed = observe_diffuse(observations, count, position, normal, lights, ks, alpha,
+                                        average, saturated_radiance, lighting);
+  if (!observed) return std::nullopt;
+  return solve_albedo(*observed);
 }
 
 }  // namespace glint::reflectance

@@ -89,13 +89,37 @@ inline AlbedoVerdict judge_albedo(float refined, bool lower_bound, float referen
   return {false, std::max(0.0f, 1 - refined / reference)};
 }
 
-// Eq. (7) over the voxel's observations under `lighting` (the lights that reach it, its
-// indirect irradiance) (those seen from above the surface, at most
-// kMaxObservationsPerVoxel), combined by `average`; nullopt when there is none or no light
-// reaches the surface point. Observations with a channel at `saturated_radiance` or above have
-// clipped: their albedo would come out too dark, so they are left out unless all of them clipped
-// (their albedo then a lower bound).
-// No allocation.
+// A voxel's observations reduced to the two sides of eq. (7): the diffuse radiance, each
+// observation's radiance less its specular term, combined by an AlbedoAverage, and the
+// irradiance it answers to. kd = pi * radiance / irradiance per channel (the average commutes
+// with the division: the irradiance is the same for every observation of the voxel).
+struct DiffuseObservation {
+  Eigen::Vector3f radiance = Eigen::Vector3f::Zero();
+  // sum_l L_l cos(theta_i,l) over the lights that reach the voxel, plus its indirect irradiance.
+  Eigen::Vector3f irradiance = Eigen::Vector3f::Zero();
+  // The same as luminance (mean over channels): all of it, the lights' with cos replaced by sin
+  // (RefinedAlbedo::light_tangent), and the indirect part.
+  float cosines = 0.0f, sines = 0.0f, indirect = 0.0f;
+  bool lower_bound = false;  // every observation had clipped
+};
+
+// The observations of a voxel under `lighting` (the lights that reach it, its indirect
+// irradiance): those seen from above the surface, at most kMaxObservationsPerVoxel, combined by
+// `average`; nullopt when there is none. Observations with a channel at `saturated_radiance` or
+// above have clipped: their radiance is a lower bound, so they are left out unless all of them
+// clipped. No allocation.
+std::optional<DiffuseObservation> observe_diffuse(
+    const Observation* observations, int count, const Eigen::Vector3f& position,
+    const Eigen::Vector3f& normal, const std::vector<render::PointLight>& lights,
+    const Eigen::Vector3f& ks, float alpha, AlbedoAverage average = AlbedoAverage::mean,
+    float saturated_radiance = INFINITY, const PointLighting& lighting = {});
+
+// Eq. (7) for `observed` with `unseen` more irradiance (per channel, counted as indirect light:
+// reflectance/unseen_light.h); nullopt where no light reaches the surface point.
+std::optional<RefinedAlbedo> solve_albedo(const DiffuseObservation& observed,
+                                          const Eigen::Vector3f& unseen = Eigen::Vector3f::Zero());
+
+// Both: eq. (7) over the voxel's observations under `lighting`.
 std::optional<RefinedAlbedo> refine_albedo(
     const Observation* observations, int count, const Eigen::Vector3f& position,
     const Eigen::Vector3f& normal, const std::vector<render::PointLight>& lights,

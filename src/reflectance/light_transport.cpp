@@ -151,7 +151,13 @@ LightTransport::LightTransport(const LightTransportParams& params, std::size_t v
     throw Error("light transport", "ray_offset_m", "must be finite and >= 0");
   if (!(params.indirect_max_distance_m > 0))
     throw Error("light transport", "indirect_max_distance_m", "must be > 0");
-  if (!enabled()) return;  // no pools: lighting() answers from the parameters alone
+  positive(params.unseen_memory, "unseen_memory");
+  if (!(params.unseen_fit.min_leverage >= 1))
+    throw Error("light transport", "unseen_fit.min_leverage", "must be >= 1");
+  if (!(params.unseen_fit.min_share >= 0))
+    throw Error("light transport", "unseen_fit.min_share", "must be >= 0");
+  // No pools without shadows or the gather: lighting() answers from the parameters alone.
+  if (!params_.shadows && !params_.indirect) return;
   lit_ = make_pool<LightMask>(voxel_capacity, "light transport visibility");
   shadow_cast_ = make_pool<bool>(voxel_capacity, "light transport visibility");
   indirect_sum_ = make_pool<Eigen::Vector3f>(voxel_capacity, "light transport indirect");
@@ -273,13 +279,30 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
   });
 }
 
+void LightTransport::fuse_unseen(int segment, const RadianceLine& line) {
+  if (segment < 0) return;
+  const std::size_t s = std::size_t(segment);
+  if (s >= unseen_.size()) {
+    unseen_line_.resize(s + 1);
+    unseen_.resize(s + 1, Eigen::Vector3f::Zero());
+    unseen_fits_.resize(s + 1, 0);
+  }
+  const float weight =
+      1.0f / float(unseen_fits_[s] = std::min(unseen_fits_[s] + 1, params_.unseen_memory));
+  RadianceLine& fused = unseen_line_[s];
+  fused.slope += weight * (line.slope - fused.slope);
+  fused.intercept += weight * (line.intercept - fused.intercept);
+  fused.typical_irradiance += weight * (line.typical_irradiance - fused.typical_irradiance);
+  unseen_[s] = unseen_irradiance(fused, params_.unseen_fit.min_share);
+}
+
 PointLighting PointLightingQuery::operator()(const Eigen::Vector3f& p, const Eigen::Vector3f& n) {
   PointLighting result;
   const LightTransportParams& params = transport_.params();
   if (params.shadows) result.lit = shadow_mask(rays_, volume_, lights_, p, n, params.ray_offset_m);
-  if (params.indirect)
+  if (params.indirect || params.unseen)
     if (const int v = grid_.find(p, &blocks_); v >= 0)
-      result.indirect = transport_.lighting(v).indirect;
+      result.indirect = transport_.lighting(v, grid_.segment(v)).indirect;
   return result;
 }
 

@@ -29,6 +29,7 @@
 #include "fusion/tsdf_volume.h"
 #include "reflectance/light_incidence.h"
 #include "reflectance/observation_grid.h"
+#include "reflectance/unseen_light.h"
 #include "render/scene.h"
 
 namespace glint::reflectance {
@@ -58,6 +59,15 @@ struct LightTransportParams {
   // as dark. The pipeline sets it from the exposure.
   float saturated_radiance = INFINITY;
   std::uint64_t seed = 1;  // the rays' directions (per voxel, from its grid coordinates)
+  // Per segment, the indirect irradiance the shadows and the gather leave unexplained, fitted
+  // from its voxels (reflectance/unseen_light.h) and added to each voxel's indirect light.
+  bool unseen = false;
+  UnseenLightFitParams unseen_fit;
+  // A segment's unseen irradiance is the ratio of its fits' mean intercept and slope, the means
+  // over its first unseen_memory frames' fits, then exponential averages with that weight: it
+  // follows the gather as its estimates fill in. (The ratio of means: a frame's own ratio is
+  // noisy where its slope is small, a dark channel's.)
+  int unseen_memory = 8;
 };
 
 class LightTransport {
@@ -67,7 +77,7 @@ class LightTransport {
   LightTransport(const LightTransportParams& params, std::size_t voxel_capacity);
 
   const LightTransportParams& params() const { return params_; }
-  bool enabled() const { return params_.shadows || params_.indirect; }
+  bool enabled() const { return params_.shadows || params_.indirect || params_.unseen; }
 
   // Casts the shadow rays due for the voxels `grid` saw in its latest collect(); more than
   // kMaxShadowedLights lights: the further ones are never shadowed. `occupancy` is of `volume`
@@ -89,6 +99,19 @@ class LightTransport {
       result.indirect = indirect_sum_[v] * (float(M_PI) / float(indirect_rays_[v]));
     return result;
   }
+  // The same with its segment's unseen irradiance added to the indirect light.
+  PointLighting lighting(int v, int segment) const {
+    PointLighting result = lighting(v);
+    result.indirect += unseen(segment);
+    return result;
+  }
+  // A segment's unseen irradiance (zero before its first fit, or with unseen off).
+  Eigen::Vector3f unseen(int segment) const {
+    return segment >= 0 && std::size_t(segment) < unseen_.size() ? unseen_[std::size_t(segment)]
+                                                                 : Eigen::Vector3f::Zero();
+  }
+  // Fuses one frame's fit of a segment's radiance line (fit_radiance_line()).
+  void fuse_unseen(int segment, const RadianceLine& line);
   // Rays counted in voxel v's indirect estimate.
   int indirect_rays(int v) const { return indirect_rays_[v]; }
 
@@ -100,6 +123,10 @@ class LightTransport {
   PoolArray<std::uint16_t> indirect_rays_;   // rays counted, at most indirect_rays
   PoolArray<std::uint32_t> indirect_next_;   // index of the next direction in the voxel's sequence
   std::vector<int> due_;                     // scratch: the voxels due in a frame
+  // Per segment id: the fused radiance line, unseen_irradiance() of it, and frames fused.
+  std::vector<RadianceLine> unseen_line_;
+  std::vector<Eigen::Vector3f> unseen_;
+  std::vector<int> unseen_fits_;
 };
 
 // Surface point p's shadow rays (unit normal n): one per light in front of it, from

@@ -150,6 +150,8 @@ nlohmann::json materials_json(const ReflectancePipeline& pipeline) {
       const Sum& sum = sums.reliable.voxels > 0 ? sums.reliable : sums.all;
       entry["kd_refined_mean"] = io::vector_json((sum.kd / sum.voxels).cast<float>());
     }
+    if (pipeline.light_transport().params().unseen)
+      entry["unseen_irradiance"] = io::vector_json(pipeline.light_transport().unseen(id));
     segments.push_back(entry);
   }
   return {{"segments", segments},

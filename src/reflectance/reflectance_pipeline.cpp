@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <numeric>
+#include <span>
 #include <string>
 
 #include "core/error.h"
@@ -39,6 +40,21 @@ DepthSegmentationParams halved_segmentation_params(const ReflectanceParams& para
   for (int level = 0; level < params.segmentation_halvings; ++level)
     halved.min_segment_px = std::max(1, halved.min_segment_px / 4);
   return halved;
+}
+
+// The indices i with segment_of[i] > 0 grouped by segment (a counting sort): segment s's are
+// order[starts[s], starts[s + 1]).
+void group_by_segment(const std::vector<int>& segment_of, int segments, std::vector<int>& starts,
+                      std::vector<int>& order) {
+  starts.assign(std::size_t(segments) + 1, 0);
+  for (const int segment : segment_of)
+    if (segment > 0) ++starts[std::size_t(segment)];
+  std::exclusive_scan(starts.begin(), starts.end(), starts.begin(), 0);
+  order.resize(std::size_t(starts.back()));
+  std::vector<int> fill(starts.begin(), starts.end() - 1);
+  for (std::size_t i = 0; i < segment_of.size(); ++i)
+    if (const int segment = segment_of[i]; segment > 0)
+      order[std::size_t(fill[std::size_t(segment)]++)] = int(i);
 }
 
 }  // namespace
@@ -100,6 +116,13 @@ void ReflectancePipeline::refine_albedo_of_visible() {
   // this frame's contribution to the references.
   due_albedo_.resize(albedo_due_.size());
   due_segment_.assign(albedo_due_.size(), -1);
+  // The unseen-light fit takes the due voxels solved under light that is not grazing (as
+  // trusted ones are), whatever share of it is indirect: the shadowed ones give its intercept.
+  const bool fit_unseen = transport_.params().unseen;
+  const float max_light_tangent = tangent_of(params_.albedo_min_light_cosine);
+  fit_segment_.assign(fit_unseen ? albedo_due_.size() : 0, -1);
+  fit_irradiance_.resize(fit_segment_.size());
+  fit_radiance_.resize(fit_segment_.size());
   parallel_for_chunks(albedo_due_.size(), 64, [&](std::size_t begin, std::size_t end) {
     std::vector<FixedSums>& segment_sums = sums.local();
     for (std::size_t i = begin; i < std::min(begin + kVoxelAhead, end); ++i)
@@ -112,10 +135,19 @@ void ReflectancePipeline::refine_albedo_of_visible() {
       const int segment = grid_.segment(v);
       const SegmentMaterial* material = specular_.material(segment);
       if (!material) continue;
+      const auto observed =
+          observe_diffuse(grid_.observations(v), grid_.observation_count(v), grid_.position(v),
+                          grid_.normal(v), lights_, material->ward.ks, material->ward.alpha,
+                          params_.albedo_average, clipped, transport_.lighting(v));
+      const bool in_map = segment > 0 && segment < segments;
+      if (fit_unseen && observed && in_map && !observed->lower_bound &&
+          (observed->sines == 0 || observed->sines <= max_light_tangent * observed->cosines)) {
+        fit_segment_[i] = segment;
+        fit_irradiance_[i] = observed->irradiance;
+        fit_radiance_[i] = observed->radiance;
+      }
       const auto refined =
-          refine_albedo(grid_.observations(v), grid_.observation_count(v), grid_.position(v),
-                        grid_.normal(v), lights_, material->ward.ks, material->ward.alpha,
-                        params_.albedo_average, clipped, transport_.lighting(v));
+          observed ? solve_albedo(*observed, transport_.unseen(segment)) : std::nullopt;
       // Each voxel is written by one iteration only: the due list holds it once.
       grid_.has_refined_kd(v) = refined.has_value();
       grid_.refined_kd_reliable(v) = false;
@@ -126,7 +158,6 @@ void ReflectancePipeline::refine_albedo_of_visible() {
       grid_.refined_kd_light_tangent(v) = refined->light_tangent;
       const bool trusted_light = refined->light_cosine() >= params_.albedo_min_light_cosine &&
                                  refined->indirect_share <= params_.albedo_max_indirect_share;
-      const bool in_map = segment > 0 && segment < segments;
       if (trusted_light && in_map) {
         due_albedo_[i] = kd.maxCoeff();
         due_segment_[i] = segment;
@@ -146,6 +177,7 @@ void ReflectancePipeline::refine_albedo_of_visible() {
     }
   });
   update_albedo_references(segments);
+  if (fit_unseen) fit_unseen_light(segments);
   // Each segment's mean over its voxels solved reliably in this frame, into its
   // SegmentMaterial::kd_refined.
   for (int segment = 1; segment < segments; ++segment) {
@@ -158,22 +190,35 @@ void ReflectancePipeline::refine_albedo_of_visible() {
 }
 
 void ReflectancePipeline::update_albedo_references(int segments) {
-  // The trusted albedos of this frame's due voxels, bucketed by segment (a counting sort).
-  segment_starts_.assign(std::size_t(segments) + 1, 0);
-  for (const int segment : due_segment_)
-    if (segment > 0) ++segment_starts_[std::size_t(segment)];
-  std::exclusive_scan(segment_starts_.begin(), segment_starts_.end(), segment_starts_.begin(), 0);
-  by_segment_.resize(std::size_t(segment_starts_.back()));
-  segment_fill_.assign(segment_starts_.begin(), segment_starts_.end() - 1);
-  for (std::size_t i = 0; i < due_segment_.size(); ++i)
-    if (const int segment = due_segment_[i]; segment > 0)
-      by_segment_[std::size_t(segment_fill_[std::size_t(segment)]++)] = due_albedo_[i];
+  group_by_segment(due_segment_, segments, segment_starts_, segment_order_);
+  by_segment_.resize(segment_order_.size());
+  for (std::size_t k = 0; k < segment_order_.size(); ++k)
+    by_segment_[k] = due_albedo_[std::size_t(segment_order_[k])];
   for (int segment = 1; segment < segments; ++segment) {
     const auto first = by_segment_.begin() + segment_starts_[std::size_t(segment)];
     const auto last = by_segment_.begin() + segment_starts_[std::size_t(segment) + 1];
     if (last - first < kMinReferenceVoxels) continue;  // the last one stays
     std::nth_element(first, first + (last - first) / 2, last);
     albedo_reference_[std::size_t(segment)] = *(first + (last - first) / 2);
+  }
+}
+
+void ReflectancePipeline::fit_unseen_light(int segments) {
+  group_by_segment(fit_segment_, segments, segment_starts_, segment_order_);
+  grouped_irradiance_.resize(segment_order_.size());
+  grouped_radiance_.resize(segment_order_.size());
+  for (std::size_t k = 0; k < segment_order_.size(); ++k) {
+    grouped_irradiance_[k] = fit_irradiance_[std::size_t(segment_order_[k])];
+    grouped_radiance_[k] = fit_radiance_[std::size_t(segment_order_[k])];
+  }
+  const LightTransportParams& params = transport_.params();
+  for (int segment = 1; segment < segments; ++segment) {
+    const std::size_t first = std::size_t(segment_starts_[std::size_t(segment)]);
+    const std::size_t count = std::size_t(segment_starts_[std::size_t(segment) + 1]) - first;
+    if (const auto line = fit_radiance_line(std::span(grouped_irradiance_).subspan(first, count),
+                                            std::span(grouped_radiance_).subspan(first, count),
+                                            params.unseen_fit, fit_order_))
+      transport_.fuse_unseen(segment, *line);
   }
 }
 

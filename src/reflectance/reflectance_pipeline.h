@@ -160,12 +160,19 @@ class ReflectancePipeline {
   // and the network's albedo can be off by more than the ratio (a dark object read as grey).
   void update_albedo_references(int segments);
   static constexpr int kMinReferenceVoxels = 16;
+  // Fits each segment's unseen irradiance (reflectance/unseen_light.h) to this frame's due
+  // voxels that are neither clipped nor under grazing light, and fuses it for the next frames.
+  void fit_unseen_light(int segments);
 
-  // Scratch of refine_albedo_of_visible(): the due voxels, their trusted albedos and segments
-  // (-1: none), and the counting sort of those by segment.
+  // Scratch of refine_albedo_of_visible(): the due voxels; their trusted albedos and segments
+  // (-1: none); their known irradiance and diffuse radiance and segments (-1: not for the
+  // unseen-light fit); one of those segment lists grouped by segment.
   std::vector<int> albedo_due_, due_segment_;
   std::vector<float> due_albedo_, by_segment_;
-  std::vector<int> segment_starts_, segment_fill_;
+  std::vector<int> fit_segment_;
+  std::vector<Eigen::Vector3f> fit_irradiance_, fit_radiance_, grouped_irradiance_,
+      grouped_radiance_;
+  std::vector<int> segment_starts_, segment_order_, fit_order_;
   std::vector<float> albedo_reference_;  // per segment id; NaN: none yet
   int frame_ = 0;
 };

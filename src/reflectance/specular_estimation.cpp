@@ -65,8 +65,8 @@ void SpecularEstimator::update(const ObservationGrid& grid, const SegmentMap& se
                                const std::vector<int>& segments,
                                const std::vector<render::PointLight>& lights, int frame,
                                const LightTransport* transport) {
-  const auto lighting = [transport](int v) {
-    return transport ? transport->lighting(v) : PointLighting{};
+  const auto lighting = [transport, &grid](int v) {
+    return transport ? transport->lighting(v, grid.segment(v)) : PointLighting{};
   };
   const int count = params_.voxels_per_estimate;
   const int image_floats = 3 * hemi_.size * hemi_.size;

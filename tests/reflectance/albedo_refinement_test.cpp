@@ -326,5 +326,30 @@ TEST(AlbedoRefinement, ShadowedLightsAndIndirectLightAreTakenOutOfEquationSeven)
                    .has_value());
 }
 
+TEST(AlbedoRefinement, UnseenIrradianceCompletesTheLightOfAVoxelNoLightReaches) {
+  // Every light shadowed, no gathered light: the observations still give the diffuse radiance,
+  // and the segment's unseen irradiance the albedo.
+  const Eigen::Vector3f kd(0.5f, 0.4f, 0.2f), unseen(0.3f, 0.3f, 0.25f);
+  std::vector<render::PointLight> lights(1);
+  lights[0].position = {0, 2, 0};
+  lights[0].intensity = {3, 3, 3};
+  std::vector<Observation> obs;
+  for (int k = 0; k < 4; ++k)
+    obs.emplace_back(kd.cwiseProduct(unseen) / float(M_PI),
+                     Eigen::Vector3f(0.3f * float(k), 1, 0.1f).normalized(), k);
+  const auto observed = observe_diffuse(
+      obs.data(), int(obs.size()), Eigen::Vector3f::Zero(), Eigen::Vector3f::UnitY(), lights,
+      Eigen::Vector3f::Zero(), 0.1f, AlbedoAverage::median, INFINITY, PointLighting{.lit = 0});
+  ASSERT_TRUE(observed.has_value());
+  EXPECT_TRUE(observed->irradiance.isZero());
+  EXPECT_FALSE(solve_albedo(*observed).has_value());
+  const auto refined = solve_albedo(*observed, unseen);
+  ASSERT_TRUE(refined.has_value());
+  EXPECT_TRUE(refined->kd.isApprox(kd, 1e-3f)) << refined->kd.transpose();  // half-float colours
+  // The unseen light is the segment's estimate, not the gather's: it does not count against
+  // the voxel's trust (RefinedAlbedo::indirect_share).
+  EXPECT_FLOAT_EQ(refined->indirect_share, 0.0f);
+}
+
 }  // namespace
 }  // namespace glint::reflectance
