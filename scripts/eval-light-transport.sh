@@ -11,6 +11,9 @@
 #   before    the defaults, --shadows off --indirect off (the paper's image model),
 #   after     --shadows on,
 #   indirect  --shadows on --indirect on,
+#   before-unseen  --unseen-light on,
+#   unseen    --shadows on --unseen-light on,
+#   indirect-unseen  --shadows on --indirect on --unseen-light on,
 # plus, for the timing tables, the "indirect" settings on each rendering b at 1 cm and 2 cm with
 # ground-truth segmentation (TIMING_SCENES). Reports: OUT/<scene>-<render>-<variant>.json;
 # summary: OUT/summary.md (scripts/light-transport-summary.py).
@@ -63,6 +66,11 @@ for scene in $SCENES; do
     reconstruct "$scene" "$r" before --shadows off --indirect off --eval-every 10
     reconstruct "$scene" "$r" after --shadows on --eval-every 10
     reconstruct "$scene" "$r" indirect --shadows on --indirect on --eval-every 10
+    reconstruct "$scene" "$r" before-unseen --shadows off --indirect off --unseen-light on \
+      --eval-every 10
+    reconstruct "$scene" "$r" unseen --shadows on --unseen-light on --eval-every 10
+    reconstruct "$scene" "$r" indirect-unseen --shadows on --indirect on --unseen-light on \
+      --eval-every 10
   done
 done
 for scene in $TIMING_SCENES; do

@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Summary of scripts/eval-light-transport.sh as Markdown: per scene and rendering (a: direct
 light without shadows, b: with shadows, c: with shadows and indirect light), before (the paper's
-image model), after (shadows) and indirect (shadows and indirect light), the averaged object L1 of
+image model), before-unseen (that and the segments' unseen light), after (shadows), indirect
+(shadows and indirect light), unseen (shadows and the unseen light) and indirect-unseen (all
+three), the averaged object L1 of
 kd, refined kd, ks, alpha and the PSNR over the objects' pixels of kd, refined kd, RGB, refined
 RGB; each b and c row's gap to a; and the per-stage milliseconds per frame of the timing runs
 beside paper 1's GTX 1080 totals.
@@ -11,6 +13,7 @@ import json
 import os
 import sys
 
+VARIANTS = ["before", "before-unseen", "after", "indirect", "unseen", "indirect-unseen"]
 PAPER_TOTALS = {"2cm": {"cubes": 17.294, "bunnies": 25.023, "office": 29.763},
                 "1cm": {"cubes": 23.919, "bunnies": 44.467, "office": 54.794}}
 STAGES = ["geometry", "observations", "segmentation", "shadows", "indirect", "specular", "albedo",
@@ -45,7 +48,7 @@ def main():
              " | refined > unrefined |", "|---" * (len(columns) + 4) + "|"]
     for scene in scenes:
         for r, title in RENDERS.items():
-            for variant in ["before", "after", "indirect"]:
+            for variant in VARIANTS:
                 rep = load(out, f"{scene}-{r}-{variant}")
                 if not (rep and rep.get("evaluation")):
                     continue
@@ -63,7 +66,7 @@ def main():
         if not (base and base.get("evaluation")):
             continue
         qa = quality(base)
-        for variant in ["before", "after", "indirect"]:
+        for variant in VARIANTS:
             for r in ["b", "c"]:
                 rep = load(out, f"{scene}-{r}-{variant}")
                 if not (rep and rep.get("evaluation")):
