@@ -165,6 +165,21 @@ reflectance::ReflectanceParams params_from(const py::dict& options, std::string&
       if (normals != "gradient" && normals != "plane")
         throw Error("normals", normals, "must be gradient or plane");
       p.observations.normal_from_neighbours = normals == "plane";
+    } else if (name == "shadows") {
+      p.light_transport.shadows = value.cast<bool>();
+    } else if (name == "indirect") {
+      p.light_transport.indirect = value.cast<bool>();
+    } else if (name == "unseen_light") {
+      p.light_transport.unseen = value.cast<bool>();
+    } else if (name == "indirect_rays") {
+      const int rays = value.cast<int>();
+      if (rays < 1 || rays > 65535)
+        throw Error(name, "", fmt::format("must be in [1, 65535], got {}", rays));
+      p.light_transport.indirect_rays = rays;
+    } else if (name == "indirect_rays_per_frame") {
+      p.light_transport.indirect_rays_per_frame = int(positive(value.cast<int>()));
+    } else if (name == "ray_offset") {
+      p.light_transport.ray_offset_m = value.cast<float>();
     } else if (name == "seed") {
       p.specular.seed = p.segments.seed = value.cast<std::uint64_t>();
     } else if (name == "render_normal_radius") {

@@ -63,6 +63,18 @@ def test_materials_and_outputs_equal_cli(sequence, tmp_path):
     assert maps["segment"].dtype == np.int32 and maps["alpha"].shape == image.shape[:2]
 
 
+def test_light_transport_options_equal_cli(sequence, tmp_path, cli):
+    """Shadows, the gather and the unseen light as `--shadows on --indirect on --unseen-light on`
+    give the CLI's materials."""
+    cli("reconstruct", sequence / "seq", "--gt-lights", "--gt-poses", "--gt-segmentation",
+        "--eval-every", "0", "--obs-spacing", "0", "--no-glb", "--shadows", "on", "--indirect",
+        "on", "--unseen-light", "on", "-o", tmp_path / "cli")
+    _, reconstruction, _ = run_python(sequence, shadows=True, indirect=True, unseen_light=True)
+    cli_materials = json.loads((tmp_path / "cli/materials.json").read_text())
+    assert reconstruction.materials() == cli_materials
+    assert all("unseen_irradiance" in s for s in cli_materials["segments"])
+
+
 def test_bad_inputs(sequence):
     seq = glint.io.open_rgbd_sequence(sequence / "seq")
     lights = sequence / "cli/lights.json"
@@ -70,6 +82,8 @@ def test_bad_inputs(sequence):
         glint.Reconstruction({"width": 4, "height": 4}, lights)
     with pytest.raises(glint.Error, match="obs_voxel: must be more than 0, got -1"):
         glint.Reconstruction(seq.intrinsics, lights, obs_voxel=-1)
+    with pytest.raises(glint.Error, match="indirect_rays: must be in \\[1, 65535\\], got 0"):
+        glint.Reconstruction(seq.intrinsics, lights, indirect_rays=0)
     with pytest.raises(glint.Error, match="specular: phong: must be hemicnn or hemicnn\\+fit"):
         glint.Reconstruction(seq.intrinsics, lights, specular="phong")
     with pytest.raises(glint.Error, match="lights: light 0: needs position and intensity"):
