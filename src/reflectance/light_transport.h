@@ -62,7 +62,7 @@ struct LightTransportParams {
   // Per segment, the indirect irradiance the shadows and the gather leave unexplained, fitted
   // from its voxels (reflectance/unseen_light.h) and added to each voxel's indirect light.
   bool unseen = false;
-  UnseenLightFitParams unseen_fit;
+  UnseenLightFitParams unseen_fit{};
   // A segment's unseen irradiance is the ratio of its fits' mean intercept and slope, the means
   // over its first unseen_memory frames' fits, then exponential averages with that weight: it
   // follows the gather as its estimates fill in. (The ratio of means: a frame's own ratio is
