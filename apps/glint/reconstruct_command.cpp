@@ -70,6 +70,16 @@ struct ReconstructOptions {
   reflectance::ReflectanceParams params;
 };
 
+// An option that takes on or off into `flag`, whose value is the default shown.
+void add_on_off_option(CLI::App* command, const std::string& name, bool& flag,
+                       const std::string& help) {
+  command
+      ->add_option_function<std::string>(
+          name, [&flag](const std::string& value) { flag = value == "on"; }, help)
+      ->check(CLI::IsMember({"on", "off"}))
+      ->default_str(flag ? "on" : "off");
+}
+
 reflectance::LightEstimate load_lights(const ReconstructOptions& options) {
   if (options.ground_truth_lights) {
     const std::string scene_path = (fs::path(options.sequence) / "scene.json").string();
@@ -457,40 +467,20 @@ void register_reconstruct_command(CLI::App& app) {
           "from it) and of the gather rays' directions")
       ->default_str(std::to_string(params.specular.seed));
   reflectance::LightTransportParams& transport = params.light_transport;
-  command
-      ->add_option_function<std::string>(
-          "--shadows",
-          [options](const std::string& value) {
-            options->params.light_transport.shadows = value == "on";
-          },
-          "Shadows: eq. 7, the hemi-images, the lobe fit and the re-renderings count only the "
-          "lights a voxel's shadow ray through the fused geometry reaches (off = every light "
-          "reaches every point, as the paper)")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->default_str(transport.shadows ? "on" : "off");
-  command
-      ->add_option_function<std::string>(
-          "--indirect",
-          [options](const std::string& value) {
-            options->params.light_transport.indirect = value == "on";
-          },
-          "Interreflections: each voxel's indirect irradiance, gathered over its hemisphere from "
-          "the radiance observed on the surfaces around it, adds to the irradiance eq. 7 and the "
-          "reflectance hemi-images divide by (off = direct light only, as the paper)")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->default_str(transport.indirect ? "on" : "off");
-  command
-      ->add_option_function<std::string>(
-          "--unseen-light",
-          [options](const std::string& value) {
-            options->params.light_transport.unseen = value == "on";
-          },
-          "Per segment, the indirect irradiance that shadows and the gather leave unexplained "
-          "(light bounced off surfaces the camera never saw; all of it with --indirect off), "
-          "fitted from how the segment's diffuse radiance grows with the irradiance it is known "
-          "to get, and added to its voxels' (off = none)")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->default_str(transport.unseen ? "on" : "off");
+  add_on_off_option(command, "--shadows", transport.shadows,
+                    "Shadows: eq. 7, the hemi-images, the lobe fit and the re-renderings count "
+                    "only the lights a voxel's shadow ray through the fused geometry reaches "
+                    "(off = every light reaches every point, as the paper)");
+  add_on_off_option(command, "--indirect", transport.indirect,
+                    "Interreflections: each voxel's indirect irradiance, gathered over its "
+                    "hemisphere from the radiance observed on the surfaces around it, adds to the "
+                    "irradiance eq. 7 and the reflectance hemi-images divide by (off = direct "
+                    "light only, as the paper)");
+  add_on_off_option(command, "--unseen-light", transport.unseen,
+                    "Per segment, the indirect irradiance that shadows and the gather leave "
+                    "unexplained (light bounced off surfaces the camera never saw; all of it with "
+                    "--indirect off), fitted from how the segment's diffuse radiance grows with "
+                    "the irradiance it is known to get, and added to its voxels' (off = none)");
   command
       ->add_option("--indirect-rays", transport.indirect_rays,
                    "Cosine-weighted gather rays per voxel in its indirect estimate (afterwards a "

@@ -219,17 +219,4 @@ std::optional<RefinedAlbedo> solve_albedo(const DiffuseObservation& observed,
   return refined;
 }
 
-std::optional<RefinedAlbedo> refine_albedo(const Observation* observations, int count,
-                                           const Eigen::Vector3f& position,
-                                           const Eigen::Vector3f& normal,
-                                           const std::vector<render::PointLight>& lights,
-                                           const Eigen::Vector3f& ks, float alpha,
-                                           AlbedoAverage average, float saturated_radiance,
-                                           const PointLighting& lighting) {
-  const auto observed = observe_diffuse(observations, count, position, normal, lights, ks, alpha,
-                                        average, saturated_radiance, lighting);
-  if (!observed) return std::nullopt;
-  return solve_albedo(*observed);
-}
-
 }  // namespace glint::reflectance

@@ -119,11 +119,4 @@ std::optional<DiffuseObservation> observe_diffuse(
 std::optional<RefinedAlbedo> solve_albedo(const DiffuseObservation& observed,
                                           const Eigen::Vector3f& unseen = Eigen::Vector3f::Zero());
 
-// Both: eq. (7) over the voxel's observations under `lighting`.
-std::optional<RefinedAlbedo> refine_albedo(
-    const Observation* observations, int count, const Eigen::Vector3f& position,
-    const Eigen::Vector3f& normal, const std::vector<render::PointLight>& lights,
-    const Eigen::Vector3f& ks, float alpha, AlbedoAverage average = AlbedoAverage::mean,
-    float saturated_radiance = INFINITY, const PointLighting& lighting = {});
-
 }  // namespace glint::reflectance

@@ -105,7 +105,7 @@ void ReflectancePipeline::refine_albedo_of_visible() {
   const int segments = segment_map_.max_segment_id() + 1;
   tbb::enumerable_thread_specific<std::vector<FixedSums>> sums(std::size_t(segments),
                                                                FixedSums::Zero());
-  // Observations at or above this radiance have clipped (refine_albedo() leaves them out).
+  // Observations at or above this radiance have clipped (observe_diffuse() leaves them out).
   const float clipped =
       params_.albedo_keep_clipped ? INFINITY : saturated_radiance(params_.exposure);
   // The references of the frames before (update_albedo_references()); a segment without one

@@ -58,7 +58,7 @@ struct ReflectanceParams {
   AlbedoAverage albedo_average = AlbedoAverage::median;
   // Whether eq. (7) takes observations with a clipped channel where a voxel has others too (the
   // paper). By default they are left out: a clipped channel's albedo comes out too dark
-  // (refine_albedo()).
+  // (observe_diffuse()).
   bool albedo_keep_clipped = false;
   // A voxel whose albedo was solved under light more grazing than this effective incidence
   // cosine (RefinedAlbedo::light_cosine()) is unreliable: the re-rendering interpolates the

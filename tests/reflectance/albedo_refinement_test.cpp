@@ -7,6 +7,7 @@
 #include <cmath>
 #include <optional>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -16,6 +17,13 @@ namespace glint::reflectance {
 namespace {
 
 using test_support::observed;
+
+// Eq. (7) over a voxel's observations: observe_diffuse(), then solve_albedo().
+template <class... Args>
+std::optional<RefinedAlbedo> refine_albedo(Args&&... args) {
+  const auto diffuse = observe_diffuse(std::forward<Args>(args)...);
+  return diffuse ? solve_albedo(*diffuse) : std::nullopt;
+}
 
 TEST(AlbedoRefinement, RecoversTheDiffuseAlbedoOfARenderedVoxel) {
   render::WardMaterial m;
@@ -159,7 +167,7 @@ TEST(AlbedoRefinement, MedianIsThePerChannelMedianForEveryCount) {
         for (int c = 0; c < 3; ++c) albedos[c].push_back(obs.back().colour()[c] * float(M_PI));
       }
       const auto refined = refine_albedo(obs.data(), n, Eigen::Vector3f::Zero(), normal, lights,
-                                         {0, 0, 0}, 0.1f, AlbedoAverage::median);
+                                         Eigen::Vector3f::Zero(), 0.1f, AlbedoAverage::median);
       ASSERT_TRUE(refined);
       for (int c = 0; c < 3; ++c) {
         std::sort(albedos[c].begin(), albedos[c].end());
@@ -175,8 +183,8 @@ TEST(AlbedoRefinement, LightCosineIsTheEffectiveIncidenceOfTheLights) {
   const Observation o(Eigen::Vector3f::Constant(0.5f), Eigen::Vector3f::UnitY(), 0);
   const Eigen::Vector3f normal = Eigen::Vector3f::UnitY();
   const auto light_cosine = [&](const std::vector<render::PointLight>& lights) {
-    const RefinedAlbedo refined =
-        *refine_albedo(&o, 1, Eigen::Vector3f::Zero(), normal, lights, {0, 0, 0}, 0.1f);
+    const RefinedAlbedo refined = *refine_albedo(&o, 1, Eigen::Vector3f::Zero(), normal, lights,
+                                                 Eigen::Vector3f::Zero(), 0.1f);
     // The tangent of the same angle.
     EXPECT_NEAR(
         refined.light_tangent,
@@ -259,12 +267,15 @@ TEST(AlbedoRefinement, UnlitOrUnseenVoxelsHaveNoEstimate) {
   below[0].position = {0, -1, 0};
   Observation o(Eigen::Vector3f::Constant(0.5f), Eigen::Vector3f::UnitY(), 0);
   const Eigen::Vector3f normal = Eigen::Vector3f::UnitY();
-  EXPECT_FALSE(refine_albedo(&o, 1, Eigen::Vector3f::Zero(), normal, below, {0, 0, 0}, 0.1f));
+  EXPECT_FALSE(
+      refine_albedo(&o, 1, Eigen::Vector3f::Zero(), normal, below, Eigen::Vector3f::Zero(), 0.1f));
   std::vector<render::PointLight> above(1);
   above[0].position = {0, 1, 0};
-  EXPECT_FALSE(refine_albedo(&o, 0, Eigen::Vector3f::Zero(), normal, above, {0, 0, 0}, 0.1f));
+  EXPECT_FALSE(
+      refine_albedo(&o, 0, Eigen::Vector3f::Zero(), normal, above, Eigen::Vector3f::Zero(), 0.1f));
   o = Observation(o.colour(), -Eigen::Vector3f::UnitY(), 0);  // seen from below the surface
-  EXPECT_FALSE(refine_albedo(&o, 1, Eigen::Vector3f::Zero(), normal, above, {0, 0, 0}, 0.1f));
+  EXPECT_FALSE(
+      refine_albedo(&o, 1, Eigen::Vector3f::Zero(), normal, above, Eigen::Vector3f::Zero(), 0.1f));
 }
 
 // Observed radiance = kd / pi * (E_direct + E_indirect) + specular, with E_direct over the
