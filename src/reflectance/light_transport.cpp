@@ -281,19 +281,14 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
 
 void LightTransport::fuse_unseen(int segment, const RadianceLine& line) {
   if (segment < 0) return;
-  const std::size_t s = std::size_t(segment);
-  if (s >= unseen_.size()) {
-    unseen_line_.resize(s + 1);
-    unseen_.resize(s + 1, Eigen::Vector3f::Zero());
-    unseen_fits_.resize(s + 1, 0);
-  }
-  const float weight =
-      1.0f / float(unseen_fits_[s] = std::min(unseen_fits_[s] + 1, params_.unseen_memory));
-  RadianceLine& fused = unseen_line_[s];
-  fused.slope += weight * (line.slope - fused.slope);
-  fused.intercept += weight * (line.intercept - fused.intercept);
-  fused.typical_irradiance += weight * (line.typical_irradiance - fused.typical_irradiance);
-  unseen_[s] = unseen_irradiance(fused, params_.unseen_fit.min_share);
+  if (std::size_t(segment) >= unseen_.size()) unseen_.resize(std::size_t(segment) + 1);
+  FusedLine& fused = unseen_[std::size_t(segment)];
+  fused.frames = std::min(fused.frames + 1, params_.unseen_memory);
+  const float weight = 1.0f / float(fused.frames);
+  fused.line.slope += weight * (line.slope - fused.line.slope);
+  fused.line.intercept += weight * (line.intercept - fused.line.intercept);
+  fused.line.typical_irradiance +=
+      weight * (line.typical_irradiance - fused.line.typical_irradiance);
 }
 
 PointLighting PointLightingQuery::operator()(const Eigen::Vector3f& p, const Eigen::Vector3f& n) {

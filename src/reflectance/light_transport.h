@@ -107,8 +107,8 @@ class LightTransport {
   }
   // A segment's unseen irradiance (zero before its first fit, or with unseen off).
   Eigen::Vector3f unseen(int segment) const {
-    return segment >= 0 && std::size_t(segment) < unseen_.size() ? unseen_[std::size_t(segment)]
-                                                                 : Eigen::Vector3f::Zero();
+    if (segment < 0 || std::size_t(segment) >= unseen_.size()) return Eigen::Vector3f::Zero();
+    return unseen_irradiance(unseen_[std::size_t(segment)].line, params_.unseen_fit.min_share);
   }
   // Fuses one frame's fit of a segment's radiance line (fit_radiance_line()).
   void fuse_unseen(int segment, const RadianceLine& line);
@@ -123,10 +123,12 @@ class LightTransport {
   PoolArray<std::uint16_t> indirect_rays_;   // rays counted, at most indirect_rays
   PoolArray<std::uint32_t> indirect_next_;   // index of the next direction in the voxel's sequence
   std::vector<int> due_;                     // scratch: the voxels due in a frame
-  // Per segment id: the fused radiance line, unseen_irradiance() of it, and frames fused.
-  std::vector<RadianceLine> unseen_line_;
-  std::vector<Eigen::Vector3f> unseen_;
-  std::vector<int> unseen_fits_;
+  // Per segment id: its fused radiance line and the frames fused into it.
+  struct FusedLine {
+    RadianceLine line;
+    int frames = 0;
+  };
+  std::vector<FusedLine> unseen_;
 };
 
 // Surface point p's shadow rays (unit normal n): one per light in front of it, from
