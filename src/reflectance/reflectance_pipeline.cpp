@@ -43,15 +43,15 @@ DepthSegmentationParams halved_segmentation_params(const ReflectanceParams& para
 }
 
 // The indices i with segment_of[i] > 0 grouped by segment (a counting sort): segment s's are
-// order[starts[s], starts[s + 1]).
+// order[starts[s], starts[s + 1]). `fill` is scratch.
 void group_by_segment(const std::vector<int>& segment_of, int segments, std::vector<int>& starts,
-                      std::vector<int>& order) {
+                      std::vector<int>& fill, std::vector<int>& order) {
   starts.assign(std::size_t(segments) + 1, 0);
   for (const int segment : segment_of)
     if (segment > 0) ++starts[std::size_t(segment)];
   std::exclusive_scan(starts.begin(), starts.end(), starts.begin(), 0);
   order.resize(std::size_t(starts.back()));
-  std::vector<int> fill(starts.begin(), starts.end() - 1);
+  fill.assign(starts.begin(), starts.end() - 1);
   for (std::size_t i = 0; i < segment_of.size(); ++i)
     if (const int segment = segment_of[i]; segment > 0)
       order[std::size_t(fill[std::size_t(segment)]++)] = int(i);
@@ -190,7 +190,7 @@ void ReflectancePipeline::refine_albedo_of_visible() {
 }
 
 void ReflectancePipeline::update_albedo_references(int segments) {
-  group_by_segment(due_segment_, segments, segment_starts_, segment_order_);
+  group_by_segment(due_segment_, segments, segment_starts_, segment_fill_, segment_order_);
   by_segment_.resize(segment_order_.size());
   for (std::size_t k = 0; k < segment_order_.size(); ++k)
     by_segment_[k] = due_albedo_[std::size_t(segment_order_[k])];
@@ -204,7 +204,7 @@ void ReflectancePipeline::update_albedo_references(int segments) {
 }
 
 void ReflectancePipeline::fit_unseen_light(int segments) {
-  group_by_segment(fit_segment_, segments, segment_starts_, segment_order_);
+  group_by_segment(fit_segment_, segments, segment_starts_, segment_fill_, segment_order_);
   grouped_irradiance_.resize(segment_order_.size());
   grouped_radiance_.resize(segment_order_.size());
   for (std::size_t k = 0; k < segment_order_.size(); ++k) {

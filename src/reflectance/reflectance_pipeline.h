@@ -172,7 +172,7 @@ class ReflectancePipeline {
   std::vector<int> fit_segment_;
   std::vector<Eigen::Vector3f> fit_irradiance_, fit_radiance_, grouped_irradiance_,
       grouped_radiance_;
-  std::vector<int> segment_starts_, segment_order_, fit_order_;
+  std::vector<int> segment_starts_, segment_fill_, segment_order_, fit_order_;
   std::vector<float> albedo_reference_;  // per segment id; NaN: none yet
   int frame_ = 0;
 };
