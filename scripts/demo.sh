@@ -26,12 +26,12 @@ KODAK="$DATA/images/kodak/kodim23.png"
 "$GLINT" denoise eval --images "$KODAK" --crop 128 --methods nlm,guided-s2s --save "$OUT/denoise" \
   --report "$OUT/denoise-eval.json"
 "$GLINT" denoise noise-map "$OUT/denoise/kodim23-noisy.png" -o "$OUT/denoise/kodim23-guidance-cli.png"
-# The reflectance pipeline on a small synthetic scene: the bunnies (60 frames at 256x212) and
-# their low-exposure light capture, rendered on the fly; lights from the capture; then glint
-# reconstruct with the true poses and its own segmentation.
+# The reflectance pipeline on a small synthetic scene: the bunnies (60 frames at 256x212, direct
+# light with shadows) and their low-exposure light capture, rendered on the fly; lights from the
+# capture; then glint reconstruct with the true poses and its own segmentation.
 BUNNIES="$OUT/reflectance/bunnies"
 [[ -d "$BUNNIES" ]] || "$GLINT" --quiet synth bunnies -o "$BUNNIES" --frames 60 --width 256 \
-  --no-shadows --data "$DATA"
+  --data "$DATA"
 [[ -d "$BUNNIES-capture" ]] || "$GLINT" --quiet synth lights --scene bunnies \
   -o "$BUNNIES-capture" --frames 40 --width 256 --data "$DATA"
 "$GLINT" lights "$BUNNIES-capture" -o "$OUT/reflectance/lights.json"

@@ -8,8 +8,8 @@
 # estimates the lights once per scene from its light capture (glint lights), and reconstructs
 # each rendering with glint's own segmentation, ground-truth poses and 2 cm observation voxels,
 # scored every 10th frame against the ground truth:
-#   before    the defaults, --shadows off --indirect off (the paper's image model),
-#   after     --shadows on,
+#   before    --shadows off --indirect off (the paper's image model),
+#   after     --shadows on (the defaults),
 #   indirect  --shadows on --indirect on,
 #   before-unseen  --unseen-light on,
 #   unseen    --shadows on --unseen-light on,

@@ -17,7 +17,8 @@
 # with materials no training choice was made on (scripts/heldout-scene.py), lit as their bases.
 # VARIANT chooses the light transport the sequences are rendered with (the light captures are
 # direct light with shadows in every variant):
-#   noshadow (default) direct light without shadows, the pipeline's image model (Table 1);
+#   noshadow (default) direct light without shadows, reconstructed with --shadows off (paper 1's
+#                      image model, Table 1);
 #   shadow             direct light with shadows;
 #   bounceN            shadows and N bounces of path-traced indirect light (e.g. bounce3).
 # OUT defaults to build/eval-reflectance, or build/eval-reflectance-VARIANT for the others; an
@@ -29,10 +30,12 @@ GLINT=${1:?usage: eval-reflectance.sh GLINT DATA [OUT] [SCENES] [FRAMES]}
 DATA=${2:?usage: eval-reflectance.sh GLINT DATA [OUT] [SCENES] [FRAMES]}
 VARIANT=${VARIANT:-noshadow}
 case $VARIANT in
-  noshadow) LIGHT_TRANSPORT=(--no-shadows) DEFAULT_OUT=build/eval-reflectance ;;
-  shadow) LIGHT_TRANSPORT=() DEFAULT_OUT=build/eval-reflectance-shadow ;;
+  noshadow) LIGHT_TRANSPORT=(--no-shadows) PIPELINE=(--shadows off)
+    DEFAULT_OUT=build/eval-reflectance ;;
+  shadow) LIGHT_TRANSPORT=() PIPELINE=() DEFAULT_OUT=build/eval-reflectance-shadow ;;
   bounce[1-9] | bounce[1-9][0-9])
-    LIGHT_TRANSPORT=(--bounces "${VARIANT#bounce}") DEFAULT_OUT=build/eval-reflectance-$VARIANT ;;
+    LIGHT_TRANSPORT=(--bounces "${VARIANT#bounce}") PIPELINE=()
+    DEFAULT_OUT=build/eval-reflectance-$VARIANT ;;
   *)
     echo "eval-reflectance.sh: VARIANT must be noshadow, shadow or bounceN, not '$VARIANT'" >&2
     exit 2
@@ -71,7 +74,7 @@ for scene in $SCENES; do
     shift
     [[ -f "$OUT/$scene-$name.json" ]] && return 0  # done in an earlier run
     "$GLINT" --quiet reconstruct "$seq" --lights "$OUT/lights-$scene.json" --gt-poses \
-      -o "$OUT/$scene-$name" --report "$OUT/$scene-$name.json" "$@" \
+      -o "$OUT/$scene-$name" --report "$OUT/$scene-$name.json" "${PIPELINE[@]}" "$@" \
       > "$OUT/$scene-$name.txt"
   }
   run gtseg --gt-segmentation --model "$MODELS/hemicnn.json" --eval-every 10

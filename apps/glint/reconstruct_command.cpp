@@ -470,7 +470,8 @@ void register_reconstruct_command(CLI::App& app) {
   add_on_off_option(command, "--shadows", transport.shadows,
                     "Shadows: eq. 7, the hemi-images, the lobe fit and the re-renderings count "
                     "only the lights a voxel's shadow ray through the fused geometry reaches "
-                    "(off = every light reaches every point, as the paper)");
+                    "(off = every light reaches every point, as the paper: only for input "
+                    "rendered without shadows)");
   add_on_off_option(command, "--indirect", transport.indirect,
                     "Interreflections: each voxel's indirect irradiance, gathered over its "
                     "hemisphere from the radiance observed on the surfaces around it, adds to the "

@@ -33,7 +33,7 @@ reconstruct() {  # reconstruct NAME [taskset CPUS] -- ARGS...
   while [[ $1 != -- ]]; do prefix+=("$1"); shift; done
   shift
   "${prefix[@]}" "$GLINT" --quiet reconstruct "$seq" --lights "$lights" --gt-poses \
-    --gt-segmentation --model "$MODEL" --obs-voxel "$VOXEL" -o "$WORK/out" \
+    --gt-segmentation --model "$MODEL" --obs-voxel "$VOXEL" --shadows off -o "$WORK/out" \
     --report "$OUT/$name.json" "$@" >/dev/null && echo "$name done"
 }
 for round in $(seq "$ROUNDS"); do

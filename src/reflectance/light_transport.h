@@ -35,10 +35,12 @@
 namespace glint::reflectance {
 
 struct LightTransportParams {
-  // Both off by default, by the rule docs/decisions.md states: shadows lower the refined albedo
-  // where the input has none (light reaches what the geometry hides), and the gather where the
-  // input has no bounced light (figures: docs/benchmarks.md).
-  bool shadows = false;
+  // Shadows on and the gather off by default, by the rule docs/decisions.md states: defaults
+  // serve input whose light is physical (real captures, renderings with shadows), where shadow
+  // rays raise the refined albedo; the gather helps only where much light is bounced, at more
+  // than the rest of the pipeline's cost (figures: docs/benchmarks.md). Paper 1's image model,
+  // for renderings without shadows, is shadows = false.
+  bool shadows = true;
   bool indirect = false;
   // 2 TSDF voxels at the default 5 mm: the fused surface of a flat face scatters by about one
   // voxel, and a ray starting 1 cm above it no longer meets it (tested on a tilted plane).

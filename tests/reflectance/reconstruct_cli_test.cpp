@@ -54,6 +54,10 @@ TEST_F(ReconstructCli, WritesTheModelMaterialsLightsPicturesAndReport) {
   // --device auto: the GPU where this build has CUDA and there is one.
   EXPECT_FLOAT_EQ(report["parameters"]["albedo_smoothing"].get<float>(), 0.2f);
   EXPECT_FALSE(report["parameters"]["albedo_keep_clipped"].get<bool>());
+  // Shadow rays by default; the gather and the unseen light only when asked for.
+  EXPECT_TRUE(report["parameters"]["shadows"].get<bool>());
+  EXPECT_FALSE(report["parameters"]["indirect"].get<bool>());
+  EXPECT_FALSE(report["parameters"]["unseen_light"].get<bool>());
   EXPECT_EQ(report["parameters"]["model_input"], "radiance");  // HemiCnn's default config
   EXPECT_EQ(report["parameters"]["integration_device"],
             fusion::CudaIntegrator::available() ? "cuda" : "cpu");
@@ -75,7 +79,8 @@ TEST_F(ReconstructCli, AlbedosTheLightsCannotExplainGiveWayToTheirSegments) {
     const std::string name = "ratio" + std::to_string(ratio);
     const CommandResult result =
         glint("reconstruct " + path("shadowed") +
-              " --gt-lights --gt-poses --gt-segmentation --eval-every 4 --no-glb --model " +
+              " --gt-lights --gt-poses --gt-segmentation --eval-every 4 --no-glb --shadows off "
+              "--model " +
               path("model.json") + " --albedo-max-ratio " + std::to_string(ratio) + " -o " +
               path(name) + " --report " + path(name + ".json"));
     ASSERT_EQ(result.exit_code, 0) << result.output;
