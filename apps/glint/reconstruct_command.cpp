@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "cli_support.h"
@@ -27,6 +28,7 @@
 #include "reflectance/material_maps.h"
 #include "reflectance/reconstruction_outputs.h"
 #include "reflectance/reflectance_pipeline.h"
+#include "render/embree_scene.h"
 #include "render/scene_json.h"
 #include "scene_export_options.h"
 #include "volume_options.h"
@@ -61,6 +63,7 @@ struct ReconstructOptions {
   std::size_t frames = 0;
   std::optional<float> exposure;
   bool ground_truth_segmentation = false;
+  bool ground_truth_visibility = false;
   int evaluate_every = 5;
   int render_every = 0;  // 0: only the last frame
   std::string views;     // TUM trajectory of extra poses to re-render at the end
@@ -97,6 +100,17 @@ reflectance::LightEstimate load_lights(const ReconstructOptions& options) {
   return reflectance::load_lights(options.lights);
 }
 
+// The true scene for --gt-visibility (null without it), read before the long run.
+std::shared_ptr<const render::EmbreeScene> load_true_scene(const ReconstructOptions& options) {
+  if (!options.ground_truth_visibility) return nullptr;
+  if (!options.params.light_transport.shadows)
+    throw Error(options.sequence, "--gt-visibility", "casts shadow rays: it needs --shadows on");
+  const std::string scene_path = (fs::path(options.sequence) / "scene.json").string();
+  if (!fs::exists(scene_path))
+    throw Error(options.sequence, "--gt-visibility", "has no scene.json with the true scene");
+  return std::make_shared<const render::EmbreeScene>(render::read_scene_json(scene_path));
+}
+
 void run_reconstruct(ReconstructOptions options) {
   Stopwatch total;
   scene_export_params(options.scene);  // an unknown --up fails before the long run
@@ -111,6 +125,7 @@ void run_reconstruct(ReconstructOptions options) {
   options.params.exposure =
       options.exposure.value_or(reflectance::capture_exposure(options.sequence));
   const reflectance::LightEstimate lights = load_lights(options);
+  const std::shared_ptr<const render::EmbreeScene> true_scene = load_true_scene(options);
   const std::vector<io::StampedPose> views = options.views.empty()
                                                  ? std::vector<io::StampedPose>{}
                                                  : io::read_tum_trajectory(options.views);
@@ -125,6 +140,7 @@ void run_reconstruct(ReconstructOptions options) {
   fs::create_directories(fs::path(staging) / "frames");
   reflectance::ReflectancePipeline pipeline(sequence.intrinsics, options.params, network,
                                             lights.lights);
+  if (true_scene) pipeline.use_true_visibility(true_scene);
   reflectance::MaterialEvaluation evaluation;
   // Per frame: read; render (the re-rendering alone), evaluate (scoring and pictures); per
   // extra view: render; mesh once.
@@ -259,6 +275,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"ground_truth_poses", options.params.geometry.use_ground_truth_poses},
          {"track_model_halvings", options.params.geometry.tracking.model_halvings},
          {"ground_truth_segmentation", options.ground_truth_segmentation},
+         {"ground_truth_visibility", options.ground_truth_visibility},
          {"segment_noise", options.params.segmentation.convexity_noise_k},
          {"exposure", options.params.exposure},
          {"shadows", options.params.light_transport.shadows},
@@ -343,6 +360,11 @@ void register_reconstruct_command(CLI::App& app) {
                     "Use the dataset's ground-truth poses instead of tracking");
   command->add_flag("--gt-segmentation", options->ground_truth_segmentation,
                     "Use gt/segment ids instead of the depth segmentation (evaluation)");
+  command->add_flag("--gt-visibility", options->ground_truth_visibility,
+                    "Cast the shadow rays against the true scene of a synthetic sequence (its "
+                    "scene.json) instead of the fused geometry: the refined albedo as it would be "
+                    "if the pipeline knew every occluder, also the sides the camera never saw "
+                    "(evaluation)");
   command->add_option("--exposure", options->exposure,
                       "Exposure of the sequence (radiance = pixel / exposure); default: its "
                       "scene.json's, else 1");

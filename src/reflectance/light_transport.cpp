@@ -8,6 +8,7 @@
 #include "core/parallel.h"
 #include "fusion/ray_queue.h"
 #include "reflectance/hemi_image.h"
+#include "render/embree_scene.h"
 
 namespace glint::reflectance {
 namespace {
@@ -80,6 +81,25 @@ bool on_light(const std::vector<render::PointLight>& lights, const Eigen::Vector
 float shadow_ray_end(const render::PointLight& light, float distance,
                      const fusion::TsdfVolume& volume) {
   return distance - float(light.proxy_radius_m) - 2 * float(volume.params().voxel_size_m);
+}
+
+// Point p's shadow rays (unit normal n), one per light in front of it (of the first
+// kMaxShadowedLights), from p + offset_m * n to short of the light's proxy:
+// cast(origin, unit direction, t_max, light index).
+template <class Cast>
+void for_each_shadow_ray(const fusion::TsdfVolume& volume,
+                         const std::vector<render::PointLight>& lights, const Eigen::Vector3f& p,
+                         const Eigen::Vector3f& n, float offset_m, Cast&& cast) {
+  const Eigen::Vector3f origin = p + offset_m * n;
+  const std::size_t shadowed = std::min(lights.size(), std::size_t(kMaxShadowedLights));
+  for (std::size_t l = 0; l < shadowed; ++l) {
+    const Eigen::Vector3f to_light = lights[l].position.cast<float>() - origin;
+    if (!(n.dot(to_light) > 0)) continue;  // behind the surface: it gets no light anyway
+    const float distance = to_light.norm();
+    const float t_max = shadow_ray_end(lights[l], distance, volume);
+    if (!(t_max > 0)) continue;
+    cast(origin, Eigen::Vector3f(to_light / distance), t_max, l);
+  }
 }
 
 // Queues voxel v's next `rays` gather rays: cosine-weighted directions from its sequence, whose
@@ -169,18 +189,26 @@ ShadowRays queue_shadow_rays(fusion::RayQueue& queue, const fusion::TsdfVolume& 
                              const std::vector<render::PointLight>& lights,
                              const Eigen::Vector3f& p, const Eigen::Vector3f& n, float offset_m) {
   ShadowRays rays{.first = queue.size()};
-  const Eigen::Vector3f origin = p + offset_m * n;
-  const std::size_t shadowed = std::min(lights.size(), std::size_t(kMaxShadowedLights));
-  for (std::size_t l = 0; l < shadowed; ++l) {
-    const Eigen::Vector3f to_light = lights[l].position.cast<float>() - origin;
-    if (!(n.dot(to_light) > 0)) continue;  // behind the surface: it gets no light anyway
-    const float distance = to_light.norm();
-    const float t_max = shadow_ray_end(lights[l], distance, volume);
-    if (!(t_max > 0)) continue;
-    queue.add(origin, to_light / distance, t_max);
-    rays.queued |= LightMask{1} << l;
-  }
+  for_each_shadow_ray(volume, lights, p, n, offset_m,
+                      [&](const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
+                          float t_max, std::size_t light) {
+                        queue.add(origin, direction, t_max);
+                        rays.queued |= LightMask{1} << light;
+                      });
   return rays;
+}
+
+LightMask true_shadow_mask(const render::EmbreeScene& scene, const fusion::TsdfVolume& volume,
+                           const std::vector<render::PointLight>& lights, const Eigen::Vector3f& p,
+                           const Eigen::Vector3f& n, float offset_m) {
+  LightMask mask = kAllLights;
+  for_each_shadow_ray(volume, lights, p, n, offset_m,
+                      [&](const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
+                          float t_max, std::size_t light) {
+                        if (scene.occluded(origin, direction, t_max))
+                          mask &= ~(LightMask{1} << light);
+                      });
+  return mask;
 }
 
 LightMask shadow_mask(const fusion::RayQueue& queue, const ShadowRays& rays) {
@@ -216,6 +244,14 @@ void LightTransport::update_shadows(const ObservationGrid& grid, const fusion::T
     std::array<ShadowRays, kVoxelsPerQueue> rays;
     for (std::size_t batch = begin; batch < end; batch += kVoxelsPerQueue) {
       const std::size_t batch_end = std::min(end, batch + kVoxelsPerQueue);
+      if (true_scene_) {
+        for (std::size_t i = batch; i < batch_end; ++i) {
+          lit_[due_[i]] = true_shadow_mask(*true_scene_, volume, lights, grid.position(due_[i]),
+                                           grid.normal(due_[i]), params_.ray_offset_m);
+          shadow_cast_[due_[i]] = true;
+        }
+        continue;
+      }
       queue.clear();
       for (std::size_t i = batch; i < batch_end; ++i)
         rays[i - batch] = queue_shadow_rays(queue, volume, lights, grid.position(due_[i]),
@@ -294,7 +330,11 @@ void LightTransport::fuse_unseen(int segment, const RadianceLine& line) {
 PointLighting PointLightingQuery::operator()(const Eigen::Vector3f& p, const Eigen::Vector3f& n) {
   PointLighting result;
   const LightTransportParams& params = transport_.params();
-  if (params.shadows) result.lit = shadow_mask(rays_, volume_, lights_, p, n, params.ray_offset_m);
+  if (params.shadows)
+    result.lit = transport_.true_scene()
+                     ? true_shadow_mask(*transport_.true_scene(), volume_, lights_, p, n,
+                                        params.ray_offset_m)
+                     : shadow_mask(rays_, volume_, lights_, p, n, params.ray_offset_m);
   if (params.indirect || params.unseen)
     if (const int v = grid_.find(p, &blocks_); v >= 0)
       result.indirect = transport_.lighting(v, grid_.segment(v)).indirect;

@@ -21,6 +21,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/pool_memory.h"
@@ -31,6 +32,10 @@
 #include "reflectance/observation_grid.h"
 #include "reflectance/unseen_light.h"
 #include "render/scene.h"
+
+namespace glint::render {
+class EmbreeScene;
+}
 
 namespace glint::reflectance {
 
@@ -87,6 +92,14 @@ class LightTransport {
   void update_shadows(const ObservationGrid& grid, const fusion::TsdfVolume& volume,
                       const fusion::BlockOccupancy& occupancy,
                       const std::vector<render::PointLight>& lights, int frame);
+  // From now on, shadow rays test the true scene instead of the fused TSDF: an oracle for
+  // synthetic sequences, as ground-truth poses are (`glint reconstruct --gt-visibility`), which
+  // measures how much of the refined albedo's error is the visibility the fused geometry gives
+  // (occluders whose far sides the camera never saw).
+  void use_true_scene(std::shared_ptr<const render::EmbreeScene> scene) {
+    true_scene_ = std::move(scene);
+  }
+  const render::EmbreeScene* true_scene() const { return true_scene_.get(); }
   // Casts the gather rays due for the same voxels.
   void update_indirect(const ObservationGrid& grid, const fusion::TsdfVolume& volume,
                        const fusion::BlockOccupancy& occupancy,
@@ -125,6 +138,7 @@ class LightTransport {
   PoolArray<std::uint16_t> indirect_rays_;   // rays counted, at most indirect_rays
   PoolArray<std::uint32_t> indirect_next_;   // index of the next direction in the voxel's sequence
   std::vector<int> due_;                     // scratch: the voxels due in a frame
+  std::shared_ptr<const render::EmbreeScene> true_scene_;
   // Per segment id: its fused radiance line and the frames fused into it.
   struct FusedLine {
     RadianceLine line;
@@ -147,6 +161,10 @@ ShadowRays queue_shadow_rays(fusion::RayQueue& queue, const fusion::TsdfVolume& 
 // The lights that reach the point once `queue` has marched its rays: those not queued (behind
 // the surface, or beyond kMaxShadowedLights) and those whose ray met no surface.
 LightMask shadow_mask(const fusion::RayQueue& queue, const ShadowRays& rays);
+// The same rays tested against the true scene's objects.
+LightMask true_shadow_mask(const render::EmbreeScene& scene, const fusion::TsdfVolume& volume,
+                           const std::vector<render::PointLight>& lights, const Eigen::Vector3f& p,
+                           const Eigen::Vector3f& n, float offset_m);
 // Both for one point (the queue is cleared first).
 LightMask shadow_mask(fusion::RayQueue& queue, const fusion::TsdfVolume& volume,
                       const std::vector<render::PointLight>& lights, const Eigen::Vector3f& p,

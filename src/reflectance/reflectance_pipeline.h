@@ -14,6 +14,7 @@
 // Stage times go into timings() as "geometry", "observations", "segmentation", "shadows",
 // "indirect", "specular", "albedo" and "total" (milliseconds per frame), the rows of paper 1
 // Tables 2-3 and glint's two.
+#include <memory>
 #include <vector>
 
 #include "core/timer.h"
@@ -116,6 +117,10 @@ class ReflectancePipeline {
   const SegmentMap& segments() const { return segment_map_; }
   const SpecularEstimator& materials() const { return specular_; }
   const LightTransport& light_transport() const { return transport_; }
+  // Shadow rays against the true scene from now on (LightTransport::use_true_scene()).
+  void use_true_visibility(std::shared_ptr<const render::EmbreeScene> scene) {
+    transport_.use_true_scene(std::move(scene));
+  }
   const std::vector<render::PointLight>& lights() const { return lights_; }
   const StageTimings& timings() const { return timings_; }
   // The geometry stage's parts: "track", "raycast" (the model tracking aligns to; both only

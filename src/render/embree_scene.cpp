@@ -135,6 +135,15 @@ EmbreeScene::EmbreeScene(const Scene& scene) {
   throw_on_device_error(device_, "scene build");
 }
 
+bool EmbreeScene::occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
+                           float distance) const {
+  RTCIntersectContext incoherent;
+  rtcInitIntersectContext(&incoherent);
+  RTCRay ray = embree_ray(origin, direction, distance);
+  rtcOccluded1(shadow_scene_, &incoherent, &ray);
+  return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
+}
+
 EmbreeScene::~EmbreeScene() {
   if (camera_scene_) rtcReleaseScene(camera_scene_);
   if (shadow_scene_) rtcReleaseScene(shadow_scene_);

@@ -36,6 +36,25 @@ struct Surface {
   Eigen::Vector3f emitted_radiance = Eigen::Vector3f::Zero();  // light_proxy only
 };
 
+// A ray for Embree's queries: from origin along unit direction up to far, every geometry.
+inline RTCRay embree_ray(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
+                         float far) {
+  RTCRay ray;
+  ray.org_x = origin.x();
+  ray.org_y = origin.y();
+  ray.org_z = origin.z();
+  ray.dir_x = direction.x();
+  ray.dir_y = direction.y();
+  ray.dir_z = direction.z();
+  ray.tnear = 0.0f;
+  ray.tfar = far;
+  ray.mask = ~0u;
+  ray.id = 0;
+  ray.flags = 0;
+  ray.time = 0.0f;
+  return ray;
+}
+
 class EmbreeScene {
  public:
   // Throws glint::Error naming the mesh or texture file that cannot be read, or the object
@@ -48,6 +67,9 @@ class EmbreeScene {
   RTCScene camera_scene() const { return camera_scene_; }
   RTCScene shadow_scene() const { return shadow_scene_; }
   const Surface& surface(unsigned geometry_id) const { return surfaces_[geometry_id]; }
+  // Whether an object (not a light proxy) lies on the ray within `distance`; thread-safe.
+  bool occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
+                float distance) const;
 
  private:
   void add_triangles(Surface surface, const std::vector<Eigen::Vector3f>& world_vertices);

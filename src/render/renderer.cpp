@@ -76,36 +76,11 @@ Hit surface_hit(const Surface& surface, const RTCRayHit& ray_hit, const Eigen::V
   return hit;
 }
 
-RTCRay make_ray(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction, float far) {
-  RTCRay ray;
-  ray.org_x = origin.x();
-  ray.org_y = origin.y();
-  ray.org_z = origin.z();
-  ray.dir_x = direction.x();
-  ray.dir_y = direction.y();
-  ray.dir_z = direction.z();
-  ray.tnear = 0.0f;
-  ray.tfar = far;
-  ray.mask = ~0u;
-  ray.id = 0;
-  ray.flags = 0;
-  ray.time = 0.0f;
-  return ray;
-}
-
 RTCIntersectContext context(bool coherent) {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   if (coherent) context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
   return context;
-}
-
-bool occluded(RTCScene scene, const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
-              float distance) {
-  RTCIntersectContext incoherent = context(false);
-  RTCRay ray = make_ray(origin, direction, distance);
-  rtcOccluded1(scene, &incoherent, &ray);
-  return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
 }
 
 // Point-light geometry at a hit: unit direction, distance, and whether the light is in front.
@@ -191,8 +166,7 @@ struct Renderer::Impl {
     const float cos_i = n.dot(sample.direction);
     if (cos_i <= 0.0f || hit.geometric_normal.dot(sample.direction) <= 0.0f)
       return Eigen::Vector3f::Zero();
-    if (scene.shadows &&
-        occluded(embree.shadow_scene(), shadow_origin(hit), sample.direction, kInfinity))
+    if (scene.shadows && embree.occluded(shadow_origin(hit), sample.direction, kInfinity))
       return Eigen::Vector3f::Zero();
     return sample.radiance.cwiseProduct(ward_brdf(material, n, sample.direction, wo)) *
            (cos_i / sample.pdf);
@@ -206,8 +180,8 @@ struct Renderer::Impl {
     for (std::size_t l = 0; l < scene.lights.size(); ++l) {
       const LightPath path = light_path(hit, scene.lights[l]);
       if (!path.faces_light) continue;
-      if (scene.shadows && occluded(embree.shadow_scene(), shadow_origin(hit), path.wi,
-                                    path.distance * (1.0f - kShadowOffsetM)))
+      if (scene.shadows &&
+          embree.occluded(shadow_origin(hit), path.wi, path.distance * (1.0f - kShadowOffsetM)))
         continue;
       radiance += point_light(hit, material, wo, path, l);
     }
@@ -241,7 +215,7 @@ struct Renderer::Impl {
         throughput = throughput.cwiseProduct(sample.weight);
         const Eigen::Vector3f origin = shadow_origin(hit);
         RTCRayHit ray_hit;
-        ray_hit.ray = make_ray(origin, sample.direction, kInfinity);
+        ray_hit.ray = embree_ray(origin, sample.direction, kInfinity);
         ray_hit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         ray_hit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(embree.shadow_scene(), &incoherent, &ray_hit);
@@ -270,8 +244,8 @@ struct Renderer::Impl {
         if (!path.faces_light) continue;
         visible[x] = 1;
         if (!scene.shadows) continue;
-        row.shadow_rays[count] =
-            make_ray(shadow_origin(row.hits[x]), path.wi, path.distance * (1.0f - kShadowOffsetM));
+        row.shadow_rays[count] = embree_ray(shadow_origin(row.hits[x]), path.wi,
+                                            path.distance * (1.0f - kShadowOffsetM));
         row.shadow_pixels[count++] = x;
       }
       if (count == 0) continue;
@@ -312,7 +286,7 @@ FrameBuffers Renderer::render(const Pose& camera_to_world, int frame_index) cons
       for (int x = 0; x < width; ++x) {
         const Eigen::Vector3f direction = rotation * intrinsics.ray(x, double(y)).cast<float>();
         RTCRayHit& ray_hit = row.camera_rays[x];
-        ray_hit.ray = make_ray(origin, direction, kInfinity);
+        ray_hit.ray = embree_ray(origin, direction, kInfinity);
         ray_hit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         ray_hit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
       }

@@ -1,7 +1,7 @@
 // Shadows and interreflections of the reflectance pipeline (reflectance/light_transport.h): a
-// voxel behind an occluder gets no light from that light, and the gathered one-bounce irradiance
-// of a grey floor beside a white wall under one point light against a fine quadrature of the
-// wall's radiance.
+// voxel behind an occluder gets no light from that light, also where only the true scene holds
+// the occluder, and the gathered one-bounce irradiance of a grey floor beside a white wall under
+// one point light against a fine quadrature of the wall's radiance.
 #include "reflectance/light_transport.h"
 
 #include <gtest/gtest.h>
@@ -10,11 +10,13 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "core/error.h"
 #include "fusion/block_occupancy.h"
 #include "fusion/fusion_test_support.h"
+#include "render/embree_scene.h"
 #include "render/trajectories.h"
 
 namespace glint::reflectance {
@@ -166,6 +168,55 @@ TEST(LightTransport, AVoxelBehindAnOccluderGetsNoLightFromThatLight) {
             kAllLights);
   EXPECT_EQ(shadow_mask(queue, scene.geometry(), lights, {0, 0, 1}, facing, 0.01f),
             kAllLights & ~LightMask{1});
+}
+
+TEST(LightTransport, WithTheTrueSceneAnOccluderTheFusedGeometryLacksStillCastsItsShadow) {
+  // The wall and light 0 of the test above; the plate exists only in the true scene (the camera
+  // never saw it), so shadow rays through the fused wall alone find every light.
+  const Box wall{{-1, -1, 1}, {1, 1, 1.1}};
+  BoxScene scene({wall}, [](const Eigen::Vector3d&, const Eigen::Vector3d&) {
+    return Eigen::Vector3f(0.3f, 0.3f, 0.3f);
+  });
+  scene.see(render::look_at({0, 0, 0.1}, {0, 0, 1}), kWideCamera, 0);
+  const std::vector<render::PointLight> lights{light_at({0, 0, 0.3})};
+  render::Scene truth;
+  for (const auto& [centre, size] :
+       {std::pair{Eigen::Vector3d(0, 0, 1.05), Eigen::Vector3d(2, 2, 0.1)},
+        std::pair{Eigen::Vector3d(0, 0, 0.625), Eigen::Vector3d(0.2, 0.2, 0.05)}}) {
+    render::Object box;
+    box.size = size;
+    box.transform.translation() = centre;
+    truth.objects.push_back(box);
+  }
+  LightTransport fused({.shadows = true}, scene.grid().voxel_pool_size());
+  LightTransport oracle({.shadows = true}, scene.grid().voxel_pool_size());
+  oracle.use_true_scene(std::make_shared<const render::EmbreeScene>(truth));
+  const fusion::BlockOccupancy occupancy(scene.geometry());
+  fused.update_shadows(scene.grid(), scene.geometry(), occupancy, lights, 0);
+  oracle.update_shadows(scene.grid(), scene.geometry(), occupancy, lights, 0);
+  int shadowed = 0, lit = 0;
+  for (const VisibleVoxel& seen : scene.grid().visible()) {
+    const int v = seen.voxel;
+    if (!scene.grid().has_surface(v)) continue;
+    const Eigen::Vector3f p = scene.grid().position(v);
+    const float extent = std::max(std::abs(p.x()), std::abs(p.y()));
+    EXPECT_TRUE(fused.lighting(v).reaches(0)) << p.transpose();
+    if (extent < 0.18f) {
+      EXPECT_FALSE(oracle.lighting(v).reaches(0)) << p.transpose();
+      ++shadowed;
+    } else if (extent > 0.26f) {
+      EXPECT_TRUE(oracle.lighting(v).reaches(0)) << p.transpose();
+      ++lit;
+    }
+  }
+  EXPECT_GT(shadowed, 100);
+  EXPECT_GT(lit, 50);
+
+  // A re-rendering's pixels ask the same of the true scene.
+  PointLightingQuery query(oracle, scene.grid(), scene.geometry(), occupancy, lights);
+  const Eigen::Vector3f facing(0, 0, -1);
+  EXPECT_FALSE(query({0, 0, 1}, facing).reaches(0));
+  EXPECT_TRUE(query({0.5f, 0.5f, 1}, facing).reaches(0));
 }
 
 // The irradiance at floor point p (normal +y) from a Lambertian wall face x = 0 (normal +x),

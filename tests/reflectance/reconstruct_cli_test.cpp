@@ -277,6 +277,32 @@ TEST_F(ReconstructCli, BadInputsFailClearly) {
   EXPECT_NE(result.output.find("frame 2"), std::string::npos) << result.output;
   EXPECT_NE(result.output.find("no ground-truth camera pose"), std::string::npos) << result.output;
   EXPECT_FALSE(fs::exists(path("y")));
+  // --gt-visibility needs the true scene and shadow rays.
+  fs::copy(path("seq"), path("unknown"), fs::copy_options::recursive);
+  fs::remove(path("unknown") + "/scene.json");
+  std::ofstream(path("lights.json"))
+      << R"({"lights": [{"position": [0, 2, 0], "intensity": [1, 1, 1]}]})";
+  result = glint("reconstruct " + path("unknown") + " --lights " + path("lights.json") +
+                 " --gt-visibility -o " + path("y"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("--gt-visibility"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("scene.json"), std::string::npos) << result.output;
+  result = glint("reconstruct " + path("seq") + " --gt-lights --gt-visibility --shadows off -o " +
+                 path("y"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("--shadows on"), std::string::npos) << result.output;
+  EXPECT_FALSE(fs::exists(path("y")));
+}
+
+TEST_F(ReconstructCli, CastsShadowRaysAgainstTheTrueSceneWhenAsked) {
+  const CommandResult result =
+      glint("reconstruct " + path("seq") + " --gt-lights --gt-poses --gt-visibility --model " +
+            path("model.json") + " --frames 8 --no-glb -o " + path("out") + " --report " +
+            path("report.json"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const nlohmann::json report = io::read_json(path("report.json"));
+  EXPECT_TRUE(report["parameters"]["ground_truth_visibility"].get<bool>());
+  EXPECT_GT(report["timings_ms"]["shadows"]["count"].get<int>(), 0);
 }
 
 }  // namespace
