@@ -279,6 +279,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"segment_noise", options.params.segmentation.convexity_noise_k},
          {"exposure", options.params.exposure},
          {"shadows", options.params.light_transport.shadows},
+         {"shadow_test", options.params.light_transport.shadow_test},
          {"indirect", options.params.light_transport.indirect},
          {"unseen_light", options.params.light_transport.unseen},
          {"indirect_rays", options.params.light_transport.indirect_rays},
@@ -494,6 +495,12 @@ void register_reconstruct_command(CLI::App& app) {
                     "only the lights a voxel's shadow ray through the fused geometry reaches "
                     "(off = every light reaches every point, as the paper: only for input "
                     "rendered without shadows)");
+  add_on_off_option(command, "--shadow-test", transport.shadow_test,
+                    "With --shadows on: shadows the fused geometry misses (occluders whose far "
+                    "side the camera never saw). A voxel whose albedo differs from its segment's "
+                    "by more than 1.2x leaves out the light, among those whose shadow ray grazes "
+                    "fused geometry, that brings its albedo nearest its segment's (may flatten "
+                    "texture there)");
   add_on_off_option(command, "--indirect", transport.indirect,
                     "Interreflections: each voxel's indirect irradiance, gathered over its "
                     "hemisphere from the radiance observed on the surfaces around it, adds to the "

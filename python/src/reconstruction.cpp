@@ -167,6 +167,8 @@ reflectance::ReflectanceParams params_from(const py::dict& options, std::string&
       p.observations.normal_from_neighbours = normals == "plane";
     } else if (name == "shadows") {
       p.light_transport.shadows = value.cast<bool>();
+    } else if (name == "shadow_test") {
+      p.light_transport.shadow_test = value.cast<bool>();
     } else if (name == "indirect") {
       p.light_transport.indirect = value.cast<bool>();
     } else if (name == "unseen_light") {

@@ -22,6 +22,9 @@ std::uint64_t mix(std::uint64_t z) {
 
 float fraction(float x) { return x - std::floor(x); }
 
+// Past an empty region's face: enough that rounding cannot hold the walk on it.
+constexpr float kGrazingStepM = 1e-4f;
+
 // Voxels whose rays are queued and marched together (fusion::RayQueue): enough rays to keep its
 // lanes busy, few enough that the queue stays in L1.
 constexpr std::size_t kVoxelsPerQueue = 16;
@@ -169,6 +172,10 @@ LightTransport::LightTransport(const LightTransportParams& params, std::size_t v
     throw Error("light transport", "indirect_min_rays", "must be in [0, indirect_rays]");
   if (!(params.ray_offset_m >= 0 && std::isfinite(params.ray_offset_m)))
     throw Error("light transport", "ray_offset_m", "must be finite and >= 0");
+  if (!(params.shadow_test_ratio >= 1 && params.shadow_test_gain >= 1))
+    throw Error("light transport", "shadow_test_ratio, shadow_test_gain", "must be >= 1");
+  if (!(params.shadow_test_skip_m >= 0 && params.shadow_test_margin_m >= 0))
+    throw Error("light transport", "shadow_test_skip_m, shadow_test_margin_m", "must be >= 0");
   if (!(params.indirect_max_distance_m > 0))
     throw Error("light transport", "indirect_max_distance_m", "must be > 0");
   positive(params.unseen_memory, "unseen_memory");
@@ -180,6 +187,7 @@ LightTransport::LightTransport(const LightTransportParams& params, std::size_t v
   if (!params_.shadows && !params_.indirect) return;
   lit_ = make_pool<LightMask>(voxel_capacity, "light transport visibility");
   shadow_cast_ = make_pool<bool>(voxel_capacity, "light transport visibility");
+  occluded_ = make_pool<LightMask>(voxel_capacity, "light transport visibility");
   indirect_sum_ = make_pool<Eigen::Vector3f>(voxel_capacity, "light transport indirect");
   indirect_rays_ = make_pool<std::uint16_t>(voxel_capacity, "light transport indirect");
   indirect_next_ = make_pool<std::uint32_t>(voxel_capacity, "light transport indirect");
@@ -209,6 +217,39 @@ LightMask true_shadow_mask(const render::EmbreeScene& scene, const fusion::TsdfV
                           mask &= ~(LightMask{1} << light);
                       });
   return mask;
+}
+
+LightMask grazing_lights(const fusion::BlockOccupancy& occupancy, const fusion::TsdfVolume& volume,
+                         const std::vector<render::PointLight>& lights, const Eigen::Vector3f& p,
+                         const Eigen::Vector3f& n, LightMask lit,
+                         const LightTransportParams& params) {
+  const float block = float(volume.params().block_size_m());
+  LightMask grazing = 0;
+  for_each_shadow_ray(
+      volume, lights, p, n, params.ray_offset_m,
+      [&](const Eigen::Vector3f& origin, const Eigen::Vector3f& direction, float t_max,
+          std::size_t light) {
+        if (!(lit >> light & 1)) return;
+        // Through the blocks along the ray, across the empty regions in one step each.
+        for (float t = params.shadow_test_skip_m; t < t_max - params.shadow_test_margin_m;) {
+          const Eigen::Vector3f q = origin + direction * t;
+          const Eigen::Vector3i b = (q / block).array().floor().cast<int>();
+          if (occupancy.may_hold(b.x(), b.y(), b.z())) {
+            grazing |= LightMask{1} << light;
+            return;
+          }
+          Eigen::Vector3i first, last;
+          occupancy.empty_region(b.x(), b.y(), b.z(), first, last);
+          // Regions outside the box are unbounded along two axes (INT_MIN, INT_MAX).
+          const Eigen::Vector3f low = (first.cast<float>() * block).cwiseMax(-1e9f);
+          const Eigen::Vector3f high =
+              ((last.cast<float>() + Eigen::Vector3f::Ones()) * block).cwiseMin(1e9f);
+          t += first == last
+                   ? 0.5f * block
+                   : std::max(fusion::box_exit(q, direction, low, high), 0.0f) + kGrazingStepM;
+        }
+      });
+  return grazing;
 }
 
 LightMask shadow_mask(const fusion::RayQueue& queue, const ShadowRays& rays) {
@@ -335,9 +376,12 @@ PointLighting PointLightingQuery::operator()(const Eigen::Vector3f& p, const Eig
                      ? true_shadow_mask(*transport_.true_scene(), volume_, lights_, p, n,
                                         params.ray_offset_m)
                      : shadow_mask(rays_, volume_, lights_, p, n, params.ray_offset_m);
-  if (params.indirect || params.unseen)
-    if (const int v = grid_.find(p, &blocks_); v >= 0)
-      result.indirect = transport_.lighting(v, grid_.segment(v)).indirect;
+  if (params.indirect || params.unseen || (params.shadows && params.shadow_test))
+    if (const int v = grid_.find(p, &blocks_); v >= 0) {
+      result.lit &= ~transport_.occluded(v);
+      if (params.indirect || params.unseen)
+        result.indirect = transport_.lighting(v, grid_.segment(v)).indirect;
+    }
   return result;
 }
 

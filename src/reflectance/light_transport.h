@@ -47,6 +47,18 @@ struct LightTransportParams {
   // for renderings without shadows, is shadows = false.
   bool shadows = true;
   bool indirect = false;
+  // With shadows: the albedo test of the shadows the fused geometry misses (occluders whose far
+  // side the camera never saw, docs/decisions.md "Shadows the fused geometry misses"). A voxel
+  // whose refined albedo differs from its segment's reference by more than shadow_test_ratio
+  // drops the light, among those whose shadow ray grazes fused geometry (passes through an
+  // allocated TSDF block from shadow_test_skip_m past the voxel to shadow_test_margin_m short
+  // of the light), that brings its albedo nearest the reference, if that improves the ratio by
+  // shadow_test_gain.
+  bool shadow_test = false;
+  float shadow_test_ratio = 1.2f;
+  float shadow_test_gain = 1.1f;
+  float shadow_test_skip_m = 0.1f;
+  float shadow_test_margin_m = 0.3f;
   // 2 TSDF voxels at the default 5 mm: the fused surface of a flat face scatters by about one
   // voxel, and a ray starting 1 cm above it no longer meets it (tested on a tilted plane).
   float ray_offset_m = 0.01f;
@@ -109,11 +121,20 @@ class LightTransport {
   // or not yet estimated.
   PointLighting lighting(int v) const {
     PointLighting result;
-    if (params_.shadows && shadow_cast_[v]) result.lit = lit_[v];
+    if (params_.shadows && shadow_cast_[v]) result.lit = lit_[v] & ~occluded_[v];
     if (params_.indirect && indirect_rays_[v] >= params_.indirect_min_rays)
       result.indirect = indirect_sum_[v] * (float(M_PI) / float(indirect_rays_[v]));
     return result;
   }
+  // The lights voxel v's shadow rays reach (all before they are cast, or without shadows),
+  // before the albedo test.
+  LightMask cast_lights(int v) const {
+    return params_.shadows && shadow_cast_[v] ? lit_[v] : kAllLights;
+  }
+  // The lights the albedo test found occluded at voxel v (params().shadow_test): lighting()
+  // leaves them out. Each voxel from one thread at a time.
+  void set_occluded(int v, LightMask lights) { occluded_[v] = lights; }
+  LightMask occluded(int v) const { return params_.shadows ? occluded_[v] : 0; }
   // The same with its segment's unseen irradiance added to the indirect light.
   PointLighting lighting(int v, int segment) const {
     PointLighting result = lighting(v);
@@ -134,6 +155,7 @@ class LightTransport {
   LightTransportParams params_;
   PoolArray<LightMask> lit_;
   PoolArray<bool> shadow_cast_;
+  PoolArray<LightMask> occluded_;
   PoolArray<Eigen::Vector3f> indirect_sum_;  // sum of the counted rays' radiance
   PoolArray<std::uint16_t> indirect_rays_;   // rays counted, at most indirect_rays
   PoolArray<std::uint32_t> indirect_next_;   // index of the next direction in the voxel's sequence
@@ -165,6 +187,13 @@ LightMask shadow_mask(const fusion::RayQueue& queue, const ShadowRays& rays);
 LightMask true_shadow_mask(const render::EmbreeScene& scene, const fusion::TsdfVolume& volume,
                            const std::vector<render::PointLight>& lights, const Eigen::Vector3f& p,
                            const Eigen::Vector3f& n, float offset_m);
+// Of the lights in `lit`, those whose shadow ray from p grazes fused geometry: passes through an
+// allocated block of `occupancy` from skip_m along it to margin_m short of its end
+// (LightTransportParams::shadow_test).
+LightMask grazing_lights(const fusion::BlockOccupancy& occupancy, const fusion::TsdfVolume& volume,
+                         const std::vector<render::PointLight>& lights, const Eigen::Vector3f& p,
+                         const Eigen::Vector3f& n, LightMask lit,
+                         const LightTransportParams& params);
 // Both for one point (the queue is cleared first).
 LightMask shadow_mask(fusion::RayQueue& queue, const fusion::TsdfVolume& volume,
                       const std::vector<render::PointLight>& lights, const Eigen::Vector3f& p,

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <numeric>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -86,7 +87,45 @@ ReflectancePipeline::ReflectancePipeline(const Intrinsics& intrinsics,
                 "needs at least one light (estimate them with `glint lights`)");
 }
 
-void ReflectancePipeline::refine_albedo_of_visible() {
+LightMask ReflectancePipeline::test_shadows(int v, const SegmentMaterial& material, float reference,
+                                            const fusion::BlockOccupancy& occupancy, float clipped,
+                                            DiffuseObservation& observed) const {
+  const LightTransportParams& params = transport_.params();
+  const int segment = grid_.segment(v);
+  // |log| of the ratio of the albedo (largest channel) to the reference.
+  const auto misfit = [&](const DiffuseObservation& candidate) {
+    const auto solved = solve_albedo(candidate, transport_.unseen(segment));
+    return solved && solved->kd.maxCoeff() > 0
+               ? std::abs(std::log(solved->kd.maxCoeff() / reference))
+               : INFINITY;
+  };
+  float best = misfit(observed);
+  if (!(best > std::log(params.shadow_test_ratio))) return 0;
+  PointLighting lighting = transport_.lighting(v);
+  lighting.lit = transport_.cast_lights(v);
+  const LightMask candidates =
+      grazing_lights(occupancy, geometry_.volume(), lights_, grid_.position(v), grid_.normal(v),
+                     lighting.lit, params);
+  LightMask dropped = 0;
+  for (LightMask left = candidates; left != 0; left &= left - 1) {
+    const LightMask light = left & -left;
+    PointLighting without = lighting;
+    without.lit &= ~light;
+    const auto candidate = observe_diffuse(
+        grid_.observations(v), grid_.observation_count(v), grid_.position(v), grid_.normal(v),
+        lights_, material.ward.ks, material.ward.alpha, params_.albedo_average, clipped, without);
+    if (!candidate) continue;
+    const float fit = misfit(*candidate);
+    if (fit < best - std::log(params.shadow_test_gain)) {
+      best = fit;
+      dropped = light;
+      observed = *candidate;
+    }
+  }
+  return dropped;
+}
+
+void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy* occupancy) {
   // Due: voxels never refined, and those whose turn in the refresh cycle it is.
   albedo_due_.clear();
   for (const VisibleVoxel& seen : grid_.visible())
@@ -123,6 +162,8 @@ void ReflectancePipeline::refine_albedo_of_visible() {
   fit_segment_.assign(fit_unseen ? albedo_due_.size() : 0, -1);
   fit_irradiance_.resize(fit_segment_.size());
   fit_radiance_.resize(fit_segment_.size());
+  const bool shadow_test =
+      occupancy && transport_.params().shadows && transport_.params().shadow_test;
   parallel_for_chunks(albedo_due_.size(), 64, [&](std::size_t begin, std::size_t end) {
     std::vector<FixedSums>& segment_sums = sums.local();
     for (std::size_t i = begin; i < std::min(begin + kVoxelAhead, end); ++i)
@@ -135,11 +176,20 @@ void ReflectancePipeline::refine_albedo_of_visible() {
       const int segment = grid_.segment(v);
       const SegmentMaterial* material = specular_.material(segment);
       if (!material) continue;
-      const auto observed =
+      const bool in_map = segment > 0 && segment < segments;
+      const bool known = in_map && !std::isnan(albedo_reference_[std::size_t(segment)]);
+      PointLighting lighting = transport_.lighting(v);
+      if (shadow_test) lighting.lit = transport_.cast_lights(v);
+      auto observed =
           observe_diffuse(grid_.observations(v), grid_.observation_count(v), grid_.position(v),
                           grid_.normal(v), lights_, material->ward.ks, material->ward.alpha,
-                          params_.albedo_average, clipped, transport_.lighting(v));
-      const bool in_map = segment > 0 && segment < segments;
+                          params_.albedo_average, clipped, lighting);
+      if (shadow_test)
+        transport_.set_occluded(
+            v, observed && known
+                   ? test_shadows(v, *material, albedo_reference_[std::size_t(segment)], *occupancy,
+                                  clipped, *observed)
+                   : 0);
       if (fit_unseen && observed && in_map && !observed->lower_bound &&
           (observed->sines == 0 || observed->sines <= max_light_tangent * observed->cosines)) {
         fit_segment_[i] = segment;
@@ -162,7 +212,6 @@ void ReflectancePipeline::refine_albedo_of_visible() {
         due_albedo_[i] = kd.maxCoeff();
         due_segment_[i] = segment;
       }
-      const bool known = in_map && !std::isnan(albedo_reference_[std::size_t(segment)]);
       const float reference =
           known ? albedo_reference_[std::size_t(segment)] : material->ward.kd.maxCoeff();
       const AlbedoVerdict verdict =
@@ -273,12 +322,13 @@ ReflectanceFrame ReflectancePipeline::process(const io::RgbdFrame& frame,
   timings_.add("segmentation", stage.elapsed_ms());
 
   stage.restart();
+  std::optional<fusion::BlockOccupancy> occupancy;
   if (transport_.enabled()) {
-    const fusion::BlockOccupancy occupancy(geometry_.volume());
-    transport_.update_shadows(grid_, geometry_.volume(), occupancy, lights_, frame_);
+    occupancy.emplace(geometry_.volume());
+    transport_.update_shadows(grid_, geometry_.volume(), *occupancy, lights_, frame_);
     timings_.add("shadows", stage.elapsed_ms());
     stage.restart();
-    transport_.update_indirect(grid_, geometry_.volume(), occupancy, lights_, frame_);
+    transport_.update_indirect(grid_, geometry_.volume(), *occupancy, lights_, frame_);
     timings_.add("indirect", stage.elapsed_ms());
     stage.restart();
   }
@@ -287,7 +337,7 @@ ReflectanceFrame ReflectancePipeline::process(const io::RgbdFrame& frame,
   timings_.add("specular", stage.elapsed_ms());
 
   stage.restart();
-  refine_albedo_of_visible();
+  refine_albedo_of_visible(occupancy ? &*occupancy : nullptr);
   timings_.add("albedo", stage.elapsed_ms());
   timings_.add("total", total.elapsed_ms());
   ++frame_;

@@ -219,6 +219,31 @@ TEST(LightTransport, WithTheTrueSceneAnOccluderTheFusedGeometryLacksStillCastsIt
   EXPECT_TRUE(query({0.5f, 0.5f, 1}, facing).reaches(0));
 }
 
+TEST(LightTransport, ShadowRaysThatPassFusedGeometryAreTheShadowTestsCandidates) {
+  // The wall and plate of the first test, both fused. From the wall's centre, light 0's ray
+  // crosses the plate's blocks; light 1's passes 50 cm beside it and meets no block.
+  const Box wall{{-1, -1, 1}, {1, 1, 1.1}}, plate{{-0.1, -0.1, 0.6}, {0.1, 0.1, 0.65}};
+  BoxScene scene({wall, plate}, [](const Eigen::Vector3d&, const Eigen::Vector3d&) {
+    return Eigen::Vector3f(0.3f, 0.3f, 0.3f);
+  });
+  const std::vector<render::PointLight> lights{light_at({0, 0, 0.3}), light_at({1.2, 0, 0.3})};
+  const fusion::BlockOccupancy occupancy(scene.geometry());
+  // Past the wall's blocks: fill_analytic() allocates those within 8 cm of a surface.
+  const LightTransportParams params{
+      .shadows = true, .shadow_test = true, .shadow_test_skip_m = 0.2f};
+  const Eigen::Vector3f centre(0, 0, 1), facing(0, 0, -1);
+  EXPECT_EQ(grazing_lights(occupancy, scene.geometry(), lights, centre, facing, kAllLights, params),
+            LightMask{1});
+  // Only the lights asked about.
+  EXPECT_EQ(
+      grazing_lights(occupancy, scene.geometry(), lights, centre, facing, LightMask{2}, params),
+      LightMask{0});
+  // Off the plate's shadow, no ray meets a block past the wall's.
+  EXPECT_EQ(grazing_lights(occupancy, scene.geometry(), lights, {0.7f, 0.7f, 1}, facing, kAllLights,
+                           params),
+            LightMask{0});
+}
+
 // The irradiance at floor point p (normal +y) from a Lambertian wall face x = 0 (normal +x),
 // y in [0, 0.6], z in [-0.4, 0.4], of radiance wall(w): E = int L cos_p cos_w / d^2 dA, by the
 // midpoint rule on 2 mm cells (at least 15 cm away: below 0.1 % off).
@@ -300,6 +325,8 @@ TEST(LightTransport, RejectsBadParameters) {
   EXPECT_THROW(LightTransport({.indirect_rays = 8, .indirect_min_rays = 9}, 16), Error);
   EXPECT_THROW(LightTransport({.ray_offset_m = -0.01f}, 16), Error);
   EXPECT_THROW(LightTransport({.shadow_refresh_frames = 0}, 16), Error);
+  EXPECT_THROW(LightTransport({.shadow_test_ratio = 0.9f}, 16), Error);
+  EXPECT_THROW(LightTransport({.shadow_test_skip_m = -1}, 16), Error);
 }
 
 }  // namespace
