@@ -16,6 +16,9 @@
 //    indirect_refresh_frames frames. A ray that leaves the reconstruction counts as dark; one that
 //    hits a surface never observed, or one from behind, is not counted (no radiance is known
 //    there).
+// Where the fused geometry lacks an occluder (a part the camera never saw), the shadow test
+// (LightTransportParams::shadow_test) lets a voxel's albedo name the light its ray missed; the
+// true scene of a synthetic sequence can stand in for the TSDF as an oracle (use_true_scene()).
 // Rays start ray_offset_m off the surface point along its normal: the point is the TSDF's zero
 // crossing, which a ray starting on it would find again (self-shadowing acne).
 #include <Eigen/Core>

@@ -88,6 +88,7 @@ ReflectancePipeline::ReflectancePipeline(const Intrinsics& intrinsics,
 }
 
 LightMask ReflectancePipeline::test_shadows(int v, const SegmentMaterial& material, float reference,
+                                            const PointLighting& lighting,
                                             const fusion::BlockOccupancy& occupancy, float clipped,
                                             DiffuseObservation& observed) const {
   const LightTransportParams& params = transport_.params();
@@ -101,8 +102,6 @@ LightMask ReflectancePipeline::test_shadows(int v, const SegmentMaterial& materi
   };
   float best = misfit(observed);
   if (!(best > std::log(params.shadow_test_ratio))) return 0;
-  PointLighting lighting = transport_.lighting(v);
-  lighting.lit = transport_.cast_lights(v);
   const LightMask candidates =
       grazing_lights(occupancy, geometry_.volume(), lights_, grid_.position(v), grid_.normal(v),
                      lighting.lit, params);
@@ -187,8 +186,8 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
       if (shadow_test)
         transport_.set_occluded(
             v, observed && known
-                   ? test_shadows(v, *material, albedo_reference_[std::size_t(segment)], *occupancy,
-                                  clipped, *observed)
+                   ? test_shadows(v, *material, albedo_reference_[std::size_t(segment)], lighting,
+                                  *occupancy, clipped, *observed)
                    : 0);
       if (fit_unseen && observed && in_map && !observed->lower_bound &&
           (observed->sines == 0 || observed->sines <= max_light_tangent * observed->cosines)) {

@@ -144,11 +144,11 @@ class ReflectancePipeline {
   // `occupancy`: of the geometry as it is now, for the shadow test (null without shadows).
   void refine_albedo_of_visible(const fusion::BlockOccupancy* occupancy);
   // The lights to leave out of voxel v's eq. (7), by the shadow test
-  // (LightTransportParams::shadow_test): `observed` is under its cast lights and becomes the
-  // observation under those it keeps.
+  // (LightTransportParams::shadow_test): `observed` is under `lighting` (its cast lights) and
+  // becomes the observation under those it keeps.
   LightMask test_shadows(int v, const SegmentMaterial& material, float reference,
-                         const fusion::BlockOccupancy& occupancy, float clipped,
-                         DiffuseObservation& observed) const;
+                         const PointLighting& lighting, const fusion::BlockOccupancy& occupancy,
+                         float clipped, DiffuseObservation& observed) const;
   // The depth segmentation's labels at full resolution: the segmenter's own without halvings,
   // else frame_labels_ filled from the coarse ones.
   const Image<std::int32_t>& segment_frame(const ImageF& depth_m);

@@ -119,6 +119,31 @@ render::PointLight light_at(const Eigen::Vector3d& position) {
   return light;
 }
 
+// Light 0 of a plate's shadow on the wall's face z = 1 (as the first test sets them up), as the
+// last view saw the wall: no light within |x|, |y| < 0.18, light beyond 0.26 (no acne on the open
+// wall), each part seen; `also(voxel, surface point)` checks more of each wall voxel.
+template <class Also>
+void expect_plate_shadow(const BoxScene& scene, const LightTransport& transport, Also also) {
+  int shadowed = 0, lit = 0;
+  for (const VisibleVoxel& seen : scene.grid().visible()) {
+    const int v = seen.voxel;
+    if (!scene.grid().has_surface(v)) continue;
+    const Eigen::Vector3f p = scene.grid().position(v);
+    if (p.z() < 0.99f) continue;  // the plate's
+    const float extent = std::max(std::abs(p.x()), std::abs(p.y()));
+    if (extent < 0.18f) {
+      EXPECT_FALSE(transport.lighting(v).reaches(0)) << p.transpose();
+      ++shadowed;
+    } else if (extent > 0.26f) {
+      EXPECT_TRUE(transport.lighting(v).reaches(0)) << p.transpose();
+      ++lit;
+    }
+    also(v, p);
+  }
+  EXPECT_GT(shadowed, 100);
+  EXPECT_GT(lit, 50);
+}
+
 TEST(LightTransport, AVoxelBehindAnOccluderGetsNoLightFromThatLight) {
   // A wall at z = 1 facing -z; a 20 cm plate at z 0.6-0.65 in front of its centre. Light 0 at
   // z 0.3 straight in front: the plate's shadow on the wall spans |x|, |y| < 0.2-0.23. Light 1
@@ -133,28 +158,12 @@ TEST(LightTransport, AVoxelBehindAnOccluderGetsNoLightFromThatLight) {
   LightTransport transport({.shadows = true}, scene.grid().voxel_pool_size());
   const fusion::BlockOccupancy occupancy(scene.geometry());
   transport.update_shadows(scene.grid(), scene.geometry(), occupancy, lights, 0);
-  int shadowed = 0, lit = 0;
-  for (const VisibleVoxel& seen : scene.grid().visible()) {
-    const int v = seen.voxel;
-    if (!scene.grid().has_surface(v)) continue;
-    const Eigen::Vector3f p = scene.grid().position(v);
-    if (p.z() < 0.99f) continue;  // the plate's
-    const PointLighting lighting = transport.lighting(v);
-    const float extent = std::max(std::abs(p.x()), std::abs(p.y()));
-    if (extent < 0.18f) {
-      EXPECT_FALSE(lighting.reaches(0)) << p.transpose();
-      ++shadowed;
-    } else if (extent > 0.26f) {
-      EXPECT_TRUE(lighting.reaches(0)) << p.transpose();  // no acne on the open wall
-      ++lit;
-    }
+  expect_plate_shadow(scene, transport, [&](int v, const Eigen::Vector3f& p) {
     if (std::abs(p.x()) < 0.15f) {
-      EXPECT_TRUE(lighting.reaches(1)) << p.transpose();
+      EXPECT_TRUE(transport.lighting(v).reaches(1)) << p.transpose();
     }
-    EXPECT_TRUE(lighting.indirect.isZero());  // switched off
-  }
-  EXPECT_GT(shadowed, 100);
-  EXPECT_GT(lit, 50);
+    EXPECT_TRUE(transport.lighting(v).indirect.isZero());  // switched off
+  });
 
   // Switched off, every light reaches every voxel.
   LightTransport off({.shadows = false, .indirect = false}, scene.grid().voxel_pool_size());
@@ -194,23 +203,9 @@ TEST(LightTransport, WithTheTrueSceneAnOccluderTheFusedGeometryLacksStillCastsIt
   const fusion::BlockOccupancy occupancy(scene.geometry());
   fused.update_shadows(scene.grid(), scene.geometry(), occupancy, lights, 0);
   oracle.update_shadows(scene.grid(), scene.geometry(), occupancy, lights, 0);
-  int shadowed = 0, lit = 0;
-  for (const VisibleVoxel& seen : scene.grid().visible()) {
-    const int v = seen.voxel;
-    if (!scene.grid().has_surface(v)) continue;
-    const Eigen::Vector3f p = scene.grid().position(v);
-    const float extent = std::max(std::abs(p.x()), std::abs(p.y()));
+  expect_plate_shadow(scene, oracle, [&](int v, const Eigen::Vector3f& p) {
     EXPECT_TRUE(fused.lighting(v).reaches(0)) << p.transpose();
-    if (extent < 0.18f) {
-      EXPECT_FALSE(oracle.lighting(v).reaches(0)) << p.transpose();
-      ++shadowed;
-    } else if (extent > 0.26f) {
-      EXPECT_TRUE(oracle.lighting(v).reaches(0)) << p.transpose();
-      ++lit;
-    }
-  }
-  EXPECT_GT(shadowed, 100);
-  EXPECT_GT(lit, 50);
+  });
 
   // A re-rendering's pixels ask the same of the true scene.
   PointLightingQuery query(oracle, scene.grid(), scene.geometry(), occupancy, lights);
