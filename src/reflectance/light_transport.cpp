@@ -376,11 +376,12 @@ PointLighting PointLightingQuery::operator()(const Eigen::Vector3f& p, const Eig
                      ? true_shadow_mask(*transport_.true_scene(), volume_, lights_, p, n,
                                         params.ray_offset_m)
                      : shadow_mask(rays_, volume_, lights_, p, n, params.ray_offset_m);
-  if (params.indirect || params.unseen || (params.shadows && params.shadow_test))
+  // The voxel under the pixel holds its indirect light and the lights the shadow test dropped.
+  const bool indirect = params.indirect || params.unseen;
+  if (indirect || (params.shadows && params.shadow_test))
     if (const int v = grid_.find(p, &blocks_); v >= 0) {
       result.lit &= ~transport_.occluded(v);
-      if (params.indirect || params.unseen)
-        result.indirect = transport_.lighting(v, grid_.segment(v)).indirect;
+      if (indirect) result.indirect = transport_.lighting(v, grid_.segment(v)).indirect;
     }
   return result;
 }

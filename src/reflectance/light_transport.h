@@ -120,8 +120,9 @@ class LightTransport {
                        const fusion::BlockOccupancy& occupancy,
                        const std::vector<render::PointLight>& lights, int frame);
 
-  // Voxel v's lighting: all lights and no indirect light for what is switched off, not yet cast
-  // or not yet estimated.
+  // Voxel v's lighting: the lights its shadow rays reach less those the shadow test found
+  // occluded, and its indirect light; all lights and no indirect light for what is switched off,
+  // not yet cast or not yet estimated.
   PointLighting lighting(int v) const {
     PointLighting result;
     if (params_.shadows && shadow_cast_[v]) result.lit = lit_[v] & ~occluded_[v];
