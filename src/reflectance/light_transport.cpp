@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "fusion/ray_queue.h"
+#include "fusion/tsdf_sampler.h"
 #include "reflectance/hemi_image.h"
 #include "render/embree_scene.h"
 
@@ -223,7 +224,7 @@ LightMask grazing_lights(const fusion::BlockOccupancy& occupancy, const fusion::
                          const std::vector<render::PointLight>& lights, const Eigen::Vector3f& p,
                          const Eigen::Vector3f& n, LightMask lit,
                          const LightTransportParams& params) {
-  const float block = float(volume.params().block_size_m());
+  fusion::TsdfSampler sampler(volume, &occupancy);
   LightMask grazing = 0;
   for_each_shadow_ray(
       volume, lights, p, n, params.ray_offset_m,
@@ -233,20 +234,14 @@ LightMask grazing_lights(const fusion::BlockOccupancy& occupancy, const fusion::
         // Through the blocks along the ray, across the empty regions in one step each.
         for (float t = params.shadow_test_skip_m; t < t_max - params.shadow_test_margin_m;) {
           const Eigen::Vector3f q = origin + direction * t;
-          const Eigen::Vector3i b = (q / block).array().floor().cast<int>();
-          if (occupancy.may_hold(b.x(), b.y(), b.z())) {
+          float sdf;
+          if (sampler.nearest(q, sdf) != fusion::TsdfSampler::Sample::unallocated) {
             grazing |= LightMask{1} << light;
             return;
           }
-          Eigen::Vector3i first, last;
-          occupancy.empty_region(b.x(), b.y(), b.z(), first, last);
-          // Regions outside the box are unbounded along two axes (INT_MIN, INT_MAX).
-          const Eigen::Vector3f low = (first.cast<float>() * block).cwiseMax(-1e9f);
-          const Eigen::Vector3f high =
-              ((last.cast<float>() + Eigen::Vector3f::Ones()) * block).cwiseMin(1e9f);
-          t += first == last
-                   ? 0.5f * block
-                   : std::max(fusion::box_exit(q, direction, low, high), 0.0f) + kGrazingStepM;
+          Eigen::Vector3f low, high;
+          sampler.empty_box(q, low, high);
+          t += std::max(fusion::box_exit(q, direction, low, high), 0.0f) + kGrazingStepM;
         }
       });
   return grazing;

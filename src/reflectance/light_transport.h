@@ -192,8 +192,8 @@ LightMask true_shadow_mask(const render::EmbreeScene& scene, const fusion::TsdfV
                            const std::vector<render::PointLight>& lights, const Eigen::Vector3f& p,
                            const Eigen::Vector3f& n, float offset_m);
 // Of the lights in `lit`, those whose shadow ray from p grazes fused geometry: passes through an
-// allocated block of `occupancy` from skip_m along it to margin_m short of its end
-// (LightTransportParams::shadow_test).
+// allocated block of `volume` (the block of the nearest voxel, as the TSDF's samples take it)
+// from skip_m along it to margin_m short of its end (LightTransportParams::shadow_test).
 LightMask grazing_lights(const fusion::BlockOccupancy& occupancy, const fusion::TsdfVolume& volume,
                          const std::vector<render::PointLight>& lights, const Eigen::Vector3f& p,
                          const Eigen::Vector3f& n, LightMask lit,
