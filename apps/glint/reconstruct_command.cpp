@@ -29,6 +29,7 @@
 #include "reflectance/reconstruction_outputs.h"
 #include "reflectance/reflectance_pipeline.h"
 #include "render/embree_scene.h"
+#include "render/renderer.h"
 #include "render/scene_json.h"
 #include "scene_export_options.h"
 #include "volume_options.h"
@@ -64,6 +65,7 @@ struct ReconstructOptions {
   std::optional<float> exposure;
   bool ground_truth_segmentation = false;
   bool ground_truth_visibility = false;
+  bool ground_truth_indirect = false;
   int evaluate_every = 5;
   int render_every = 0;  // 0: only the last frame
   std::string views;     // TUM trajectory of extra poses to re-render at the end
@@ -100,15 +102,29 @@ reflectance::LightEstimate load_lights(const ReconstructOptions& options) {
   return reflectance::load_lights(options.lights);
 }
 
+// The scene.json of a synthetic sequence, for the oracle `flag` needs.
+render::Scene read_true_scene(const ReconstructOptions& options, const char* flag) {
+  const std::string scene_path = (fs::path(options.sequence) / "scene.json").string();
+  if (!fs::exists(scene_path))
+    throw Error(options.sequence, flag, "has no scene.json with the true scene");
+  return render::read_scene_json(scene_path);
+}
+
 // The true scene for --gt-visibility (null without it), read before the long run.
 std::shared_ptr<const render::EmbreeScene> load_true_scene(const ReconstructOptions& options) {
   if (!options.ground_truth_visibility) return nullptr;
   if (!options.params.light_transport.shadows)
     throw Error(options.sequence, "--gt-visibility", "casts shadow rays: it needs --shadows on");
-  const std::string scene_path = (fs::path(options.sequence) / "scene.json").string();
-  if (!fs::exists(scene_path))
-    throw Error(options.sequence, "--gt-visibility", "has no scene.json with the true scene");
-  return std::make_shared<const render::EmbreeScene>(render::read_scene_json(scene_path));
+  return std::make_shared<const render::EmbreeScene>(read_true_scene(options, "--gt-visibility"));
+}
+
+// The true scene's path tracer for --gt-indirect (null without it), read before the long run.
+std::shared_ptr<const render::Renderer> load_true_indirect(const ReconstructOptions& options) {
+  if (!options.ground_truth_indirect) return nullptr;
+  if (!options.params.light_transport.indirect)
+    throw Error(options.sequence, "--gt-indirect",
+                "replaces the gather's estimate: it needs --indirect on");
+  return std::make_shared<const render::Renderer>(read_true_scene(options, "--gt-indirect"));
 }
 
 void run_reconstruct(ReconstructOptions options) {
@@ -126,6 +142,7 @@ void run_reconstruct(ReconstructOptions options) {
       options.exposure.value_or(reflectance::capture_exposure(options.sequence));
   const reflectance::LightEstimate lights = load_lights(options);
   const std::shared_ptr<const render::EmbreeScene> true_scene = load_true_scene(options);
+  const std::shared_ptr<const render::Renderer> true_indirect = load_true_indirect(options);
   const std::vector<io::StampedPose> views = options.views.empty()
                                                  ? std::vector<io::StampedPose>{}
                                                  : io::read_tum_trajectory(options.views);
@@ -141,6 +158,7 @@ void run_reconstruct(ReconstructOptions options) {
   reflectance::ReflectancePipeline pipeline(sequence.intrinsics, options.params, network,
                                             lights.lights);
   if (true_scene) pipeline.use_true_visibility(true_scene);
+  if (true_indirect) pipeline.use_true_indirect(true_indirect);
   reflectance::MaterialEvaluation evaluation;
   // Per frame: read; render (the re-rendering alone), evaluate (scoring and pictures); per
   // extra view: render; mesh once.
@@ -276,6 +294,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"track_model_halvings", options.params.geometry.tracking.model_halvings},
          {"ground_truth_segmentation", options.ground_truth_segmentation},
          {"ground_truth_visibility", options.ground_truth_visibility},
+         {"ground_truth_indirect", options.ground_truth_indirect},
          {"segment_noise", options.params.segmentation.convexity_noise_k},
          {"exposure", options.params.exposure},
          {"shadows", options.params.light_transport.shadows},
@@ -366,6 +385,11 @@ void register_reconstruct_command(CLI::App& app) {
                     "scene.json) instead of the fused geometry: the refined albedo as it would be "
                     "if the pipeline knew every occluder, also the sides the camera never saw "
                     "(evaluation)");
+  command->add_flag("--gt-indirect", options->ground_truth_indirect,
+                    "With --indirect on: take each voxel's indirect irradiance from the true "
+                    "scene of a synthetic sequence (its scene.json's path tracer, as many "
+                    "bounces as it was rendered with) instead of the gather: the refined albedo "
+                    "as it would be if the pipeline knew all the bounced light (evaluation)");
   command->add_option("--exposure", options->exposure,
                       "Exposure of the sequence (radiance = pixel / exposure); default: its "
                       "scene.json's, else 1");

@@ -10,6 +10,7 @@
 #include "fusion/tsdf_sampler.h"
 #include "reflectance/hemi_image.h"
 #include "render/embree_scene.h"
+#include "render/renderer.h"
 
 namespace glint::reflectance {
 namespace {
@@ -313,6 +314,21 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
                                                                : params_.indirect_refresh_frames) ==
             0)
       due_.push_back(seen.voxel);
+  if (true_indirect_) {
+    parallel_for_chunks(due_.size(), kVoxelsPerQueue, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const int v = due_[i];
+        if (indirect_rays_[v] == n) continue;  // computed once
+        const Eigen::Vector3f& normal = grid.normal(v);
+        indirect_sum_[v] =
+            true_indirect_->indirect_irradiance(grid.position(v) + params_.ray_offset_m * normal,
+                                                normal, kTrueIndirectPaths, std::uint64_t(v)) *
+            (float(n) / float(M_PI));
+        indirect_rays_[v] = std::uint16_t(n);
+      }
+    });
+    return;
+  }
   const WorldBox box(occupancy, volume);
   // A hit this close to a light's proxy lies on it, or in an observation voxel it shares.
   const float margin = 2 * float(grid.params().voxel_size_m);

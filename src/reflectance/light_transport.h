@@ -38,7 +38,8 @@
 
 namespace glint::render {
 class EmbreeScene;
-}
+class Renderer;
+}  // namespace glint::render
 
 namespace glint::reflectance {
 
@@ -115,6 +116,17 @@ class LightTransport {
     true_scene_ = std::move(scene);
   }
   const render::EmbreeScene* true_scene() const { return true_scene_.get(); }
+  // From now on, a voxel's indirect irradiance is the true scene's instead of the gather's:
+  // Renderer::indirect_irradiance() at its surface point, ray_offset_m off it, with
+  // kTrueIndirectPaths paths, once, when it is first due. The oracle of `glint reconstruct
+  // --gt-indirect`: it measures how much of the refined albedo's error under bounced light is
+  // the gather's (surfaces the camera never saw, their radiance taken as diffuse).
+  void use_true_indirect(std::shared_ptr<const render::Renderer> renderer) {
+    true_indirect_ = std::move(renderer);
+  }
+  // Enough that a voxel's true indirect irradiance scatters by a few percent (one bounce off a
+  // surface of uniform radiance: 1 / sqrt(n) of the mean at most).
+  static constexpr int kTrueIndirectPaths = 512;
   // Casts the gather rays due for the same voxels.
   void update_indirect(const ObservationGrid& grid, const fusion::TsdfVolume& volume,
                        const fusion::BlockOccupancy& occupancy,
@@ -165,6 +177,7 @@ class LightTransport {
   PoolArray<std::uint32_t> indirect_next_;   // index of the next direction in the voxel's sequence
   std::vector<int> due_;                     // scratch: the voxels due in a frame
   std::shared_ptr<const render::EmbreeScene> true_scene_;
+  std::shared_ptr<const render::Renderer> true_indirect_;
   // Per segment id: its fused radiance line and the frames fused into it.
   struct FusedLine {
     RadianceLine line;

@@ -121,6 +121,10 @@ class ReflectancePipeline {
   void use_true_visibility(std::shared_ptr<const render::EmbreeScene> scene) {
     transport_.use_true_scene(std::move(scene));
   }
+  // Indirect irradiance from the true scene's path tracer (LightTransport::use_true_indirect()).
+  void use_true_indirect(std::shared_ptr<const render::Renderer> renderer) {
+    transport_.use_true_indirect(std::move(renderer));
+  }
   const std::vector<render::PointLight>& lights() const { return lights_; }
   const StageTimings& timings() const { return timings_; }
   // The geometry stage's parts: "track", "raycast" (the model tracking aligns to; both only

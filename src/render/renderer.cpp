@@ -197,12 +197,12 @@ struct Renderer::Impl {
   // for are sampled directly), and a ray that leaves the scene adds nothing (the environment
   // is sampled directly too); no light is counted twice. A fixed length, no Russian roulette.
   Eigen::Vector3f indirect(const Hit& first_hit, const WardMaterial& first_material,
-                           const Eigen::Vector3f& first_wo, std::uint64_t pixel,
+                           const Eigen::Vector3f& first_wo, int paths, std::uint64_t pixel,
                            int frame_index) const {
     PixelRandom random(scene.seed, frame_index, pixel, RandomPurpose::indirect);
     RTCIntersectContext incoherent = context(false);
     Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-    for (int s = 0; s < scene.indirect_samples; ++s) {
+    for (int s = 0; s < paths; ++s) {
       Hit hit = first_hit;
       WardMaterial material = first_material;
       Eigen::Vector3f wo = first_wo;
@@ -228,7 +228,7 @@ struct Renderer::Impl {
         sum += throughput.cwiseProduct(vertex_direct(hit, material, wo, random));
       }
     }
-    return sum / float(scene.indirect_samples);
+    return sum / float(paths);
   }
 
   // Which pixels of the row see each light: one coherent stream of shadow rays per light.
@@ -267,6 +267,23 @@ Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 
 const Scene& Renderer::scene() const { return impl_->scene; }
+
+Eigen::Vector3f Renderer::indirect_irradiance(const Eigen::Vector3f& p, const Eigen::Vector3f& n,
+                                              int paths, std::uint64_t key) const {
+  // A white diffuse surface reflects E / pi of any irradiance E: its indirect radiance (and its
+  // direct radiance from the environment), times pi.
+  const Hit hit{p, n, n, Eigen::Vector3f::Ones()};
+  const WardMaterial white{{1, 1, 1}, {0, 0, 0}, 0.1f};
+  Eigen::Vector3f radiance = Eigen::Vector3f::Zero();
+  if (impl_->scene.bounces > 0) radiance = impl_->indirect(hit, white, n, paths, key, 0);
+  if (impl_->environment) {
+    PixelRandom random(impl_->scene.seed, 0, key, RandomPurpose::environment);
+    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+    for (int s = 0; s < paths; ++s) sum += impl_->environment_sample(hit, white, n, random);
+    radiance += sum / float(paths);
+  }
+  return float(M_PI) * radiance;
+}
 
 FrameBuffers Renderer::render(const Pose& camera_to_world, int frame_index) const {
   const Impl& impl = *impl_;
@@ -324,7 +341,8 @@ FrameBuffers Renderer::render(const Pose& camera_to_world, int frame_index) cons
             radiance = impl.shade(hit, material, -unit_direction, row.light_visible, x, width,
                                   pixel, frame_index);
             if (impl.scene.bounces > 0)
-              radiance += impl.indirect(hit, material, -unit_direction, pixel, frame_index);
+              radiance += impl.indirect(hit, material, -unit_direction, impl.scene.indirect_samples,
+                                        pixel, frame_index);
             out.segment.plane(0)[pixel] = surface.segment_id;
             for (int c = 0; c < 3; ++c) {
               out.kd.plane(c)[pixel] = material.kd[c];

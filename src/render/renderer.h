@@ -53,6 +53,14 @@ class Renderer {
 
   const Scene& scene() const;
 
+  // The irradiance at surface point p (unit normal n, facing where the light comes from) of all
+  // light but the point lights' direct light: the light bounced off the scene (paths of up to
+  // scene.bounces vertices, as render() adds them) and the environment's. Monte Carlo over
+  // `paths` paths, seeded by scene.seed and `key`. The oracle of `glint reconstruct
+  // --gt-indirect`; zero without bounces or an environment.
+  Eigen::Vector3f indirect_irradiance(const Eigen::Vector3f& p, const Eigen::Vector3f& n, int paths,
+                                      std::uint64_t key) const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -1,5 +1,6 @@
 // The renderer's indirect light (Scene::bounces > 0): the furnace (a point light inside a
-// closed diffuse sphere, radiance in closed form for every bounce count), zero bounces and
+// closed diffuse sphere, radiance and indirect irradiance in closed form for every bounce
+// count), zero bounces and
 // convex scenes identical to the direct image, light proxies not counted twice, determinism.
 #include <gtest/gtest.h>
 
@@ -58,6 +59,27 @@ TEST(PathTracer, FurnaceSphereMatchesTheClosedFormForEveryBounceCount) {
           }
         }
         EXPECT_GT(walls, int(frame.radiance.pixel_count()) / 2);
+      }
+    }
+  }
+}
+
+// The irradiance of the bounced light at a point inside the furnace, facing a wall: with N
+// bounces each wall point leaves L0 * sum_{k<N} rho^k towards it (its direct light and N - 1
+// bounces), uniform over the hemisphere, so E = pi * that = rho * I * sum_{k<N} rho^k, zero
+// for N = 0. Every path carries exactly that (zero variance), as in the pixels above.
+TEST(PathTracer, IndirectIrradianceInTheFurnaceIsTheClosedForm) {
+  for (const float rho : {0.5f, 0.8f}) {
+    for (const int bounces : {0, 1, 3}) {
+      const Scene scene = furnace_scene(rho, bounces, 0.05);
+      const Eigen::Vector3f irradiance =
+          Renderer(scene).indirect_irradiance({0.1f, 0.0f, -0.9f}, {0, 0, 1}, 16, 7);
+      double series = 0;
+      for (int k = 0; k < bounces; ++k) series += std::pow(double(rho), k);
+      for (int c = 0; c < 3; ++c) {
+        const double expected = rho * scene.lights[0].intensity[c] * series;
+        EXPECT_NEAR(irradiance[c], expected, 1e-4 * expected + 1e-7)
+            << "rho " << rho << " bounces " << bounces << " channel " << c;
       }
     }
   }
