@@ -124,8 +124,8 @@ class LightTransport {
   void use_true_indirect(std::shared_ptr<const render::Renderer> renderer) {
     true_indirect_ = std::move(renderer);
   }
-  // Enough that a voxel's true indirect irradiance scatters by a few percent (one bounce off a
-  // surface of uniform radiance: 1 / sqrt(n) of the mean at most).
+  // The estimate's relative standard error is the incoming radiance's coefficient of variation
+  // over sqrt(512): 4.4 % of it (2,048 paths give office's (c) figures within 0.1 dB).
   static constexpr int kTrueIndirectPaths = 512;
   // Casts the gather rays due for the same voxels.
   void update_indirect(const ObservationGrid& grid, const fusion::TsdfVolume& volume,
