@@ -62,7 +62,7 @@ Segment render_segment(Eigen::Vector3f ks, float alpha,
         add((mirror + 0.15f * Eigen::Vector3f(uniform(random), uniform(random), uniform(random)))
                 .normalized());
       }
-    segment.voxels.push_back({nullptr, int(obs.size()), position, normal});
+    segment.voxels.push_back({nullptr, int(obs.size()), position, normal, PointLighting{}});
   }
   for (int v = 0; v < 25; ++v) segment.voxels[v].observations = segment.observations[v].data();
   return segment;
