@@ -190,12 +190,13 @@ struct Renderer::Impl {
   }
 
   // Indirect light at the camera's hit (the rendering equation's remaining terms up to
-  // scene.bounces further vertices): scene.indirect_samples paths per pixel, each direction
-  // drawn from the Ward mixture (render/ward_sampling.h), next-event estimation at every vertex
-  // after the first. Emission reaches the path only through next-event estimation: bounce rays
-  // trace the shadow scene, so they pass through light proxies (the point lights they stand
-  // for are sampled directly), and a ray that leaves the scene adds nothing (the environment
-  // is sampled directly too); no light is counted twice. A fixed length, no Russian roulette.
+  // scene.bounces further vertices): the mean of `paths` paths (render() takes
+  // scene.indirect_samples per pixel), each direction drawn from the Ward mixture
+  // (render/ward_sampling.h), next-event estimation at every vertex after the first. Emission
+  // reaches the path only through next-event estimation: bounce rays trace the shadow scene, so
+  // they pass through light proxies (the point lights they stand for are sampled directly), and
+  // a ray that leaves the scene adds nothing (the environment is sampled directly too); no light
+  // is counted twice. A fixed length, no Russian roulette.
   Eigen::Vector3f indirect(const Hit& first_hit, const WardMaterial& first_material,
                            const Eigen::Vector3f& first_wo, int paths, std::uint64_t pixel,
                            int frame_index) const {
