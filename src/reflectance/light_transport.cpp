@@ -315,7 +315,8 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
             0)
       due_.push_back(seen.voxel);
   if (true_indirect_) {
-    parallel_for_chunks(due_.size(), kVoxelsPerQueue, [&](std::size_t begin, std::size_t end) {
+    // Thousands of rays per voxel: small chunks keep the threads even.
+    parallel_for_chunks(due_.size(), 4, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         const int v = due_[i];
         if (indirect_rays_[v] == n) continue;  // computed once

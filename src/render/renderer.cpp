@@ -141,11 +141,18 @@ struct Renderer::Impl {
       if (light_visible[l * stride + x])
         radiance += point_light(hit, material, wo, light_path(hit, scene.lights[l]), l);
     if (!environment) return radiance;
-    const int samples = std::max(1, scene.environment->samples);
+    return radiance + environment_mean(hit, material, wo, std::max(1, scene.environment->samples),
+                                       pixel, frame_index);
+  }
+
+  // The environment's direct light at a hit: the mean of `samples` importance samples.
+  Eigen::Vector3f environment_mean(const Hit& hit, const WardMaterial& material,
+                                   const Eigen::Vector3f& wo, int samples, std::uint64_t pixel,
+                                   int frame_index) const {
     PixelRandom random(scene.seed, frame_index, pixel, RandomPurpose::environment);
     Eigen::Vector3f sum = Eigen::Vector3f::Zero();
     for (int s = 0; s < samples; ++s) sum += environment_sample(hit, material, wo, random);
-    return radiance + sum / float(samples);
+    return sum / float(samples);
   }
 
   // Light l's term of eq. (1): I / r^2 f(wi, wo) cos(theta_i), visibility already decided.
@@ -277,12 +284,7 @@ Eigen::Vector3f Renderer::indirect_irradiance(const Eigen::Vector3f& p, const Ei
   const WardMaterial white{{1, 1, 1}, {0, 0, 0}, 0.1f};
   Eigen::Vector3f radiance = Eigen::Vector3f::Zero();
   if (impl_->scene.bounces > 0) radiance = impl_->indirect(hit, white, n, paths, key, 0);
-  if (impl_->environment) {
-    PixelRandom random(impl_->scene.seed, 0, key, RandomPurpose::environment);
-    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-    for (int s = 0; s < paths; ++s) sum += impl_->environment_sample(hit, white, n, random);
-    radiance += sum / float(paths);
-  }
+  if (impl_->environment) radiance += impl_->environment_mean(hit, white, n, paths, key, 0);
   return float(M_PI) * radiance;
 }
 
