@@ -303,6 +303,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"unseen_light", options.params.light_transport.unseen},
          {"indirect_rays", options.params.light_transport.indirect_rays},
          {"indirect_rays_per_frame", options.params.light_transport.indirect_rays_per_frame},
+         {"indirect_pooling", options.params.light_transport.indirect_pooling},
          {"ray_offset_m", options.params.light_transport.ray_offset_m},
          {"model", model_path},
          {"model_input", reflectance::hemi_input_name(network.input())},
@@ -546,6 +547,11 @@ void register_reconstruct_command(CLI::App& app) {
                    "Gather rays cast per seen voxel and frame until it has --indirect-rays")
       ->check(kPositive)
       ->capture_default_str();
+  add_on_off_option(command, "--indirect-pooling", transport.indirect_pooling,
+                    "With --indirect on: a voxel's indirect estimate pools the gather rays of its "
+                    "neighbours on the same surface (within 26 degrees and half a voxel of its "
+                    "tangent plane), so it has light after a few frames and less noise (off = "
+                    "its own rays only)");
   command
       ->add_option("--ray-offset", transport.ray_offset_m,
                    "Shadow and gather rays start this far (metres) off the surface along its "

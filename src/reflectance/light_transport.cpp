@@ -193,6 +193,8 @@ LightTransport::LightTransport(const LightTransportParams& params, std::size_t v
   indirect_sum_ = make_pool<Eigen::Vector3f>(voxel_capacity, "light transport indirect");
   indirect_rays_ = make_pool<std::uint16_t>(voxel_capacity, "light transport indirect");
   indirect_next_ = make_pool<std::uint32_t>(voxel_capacity, "light transport indirect");
+  indirect_ = make_pool<Eigen::Vector3f>(voxel_capacity, "light transport indirect");
+  indirect_estimated_ = make_pool<bool>(voxel_capacity, "light transport indirect");
 }
 
 ShadowRays queue_shadow_rays(fusion::RayQueue& queue, const fusion::TsdfVolume& volume,
@@ -326,6 +328,8 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
                                                 normal, kTrueIndirectPaths, std::uint64_t(v)) *
             (float(n) / float(M_PI));
         indirect_rays_[v] = std::uint16_t(n);
+        indirect_[v] = indirect_sum_[v] * (float(M_PI) / float(n));
+        indirect_estimated_[v] = true;
       }
     });
     return;
@@ -364,6 +368,40 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
           }
         }
       }
+    }
+  });
+  estimate_indirect(grid);
+}
+
+void LightTransport::estimate_indirect(const ObservationGrid& grid) {
+  const int min_rays = params_.indirect_min_rays;
+  if (!params_.indirect_pooling) {
+    for (const int v : due_) {
+      indirect_estimated_[v] = indirect_rays_[v] >= min_rays && indirect_rays_[v] > 0;
+      if (indirect_estimated_[v])
+        indirect_[v] = indirect_sum_[v] * (float(M_PI) / float(indirect_rays_[v]));
+    }
+    return;
+  }
+  const float voxel_size = float(grid.params().voxel_size_m);
+  parallel_for_chunks(due_.size(), 64, [&](std::size_t begin, std::size_t end) {
+    ObservationGrid::BlockCache blocks;
+    std::array<int, 27> around;
+    for (std::size_t i = begin; i < end; ++i) {
+      const int v = due_[i];
+      grid.find_voxels(grid.voxel_coordinates(v) - Eigen::Vector3i::Ones(), 3, around.data(),
+                       &blocks);
+      Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+      int rays = 0;
+      for (const int u : around)
+        if (u >= 0 && indirect_rays_[u] > 0 && grid.has_surface(u) &&
+            pools_indirect_rays(grid.position(v), grid.normal(v), grid.position(u), grid.normal(u),
+                                voxel_size)) {
+          sum += indirect_sum_[u];
+          rays += indirect_rays_[u];
+        }
+      indirect_estimated_[v] = rays >= min_rays && rays > 0;
+      if (indirect_estimated_[v]) indirect_[v] = sum * (float(M_PI) / float(rays));
     }
   });
 }

@@ -1,7 +1,8 @@
 // Shadows and interreflections of the reflectance pipeline (reflectance/light_transport.h): a
 // voxel behind an occluder gets no light from that light, also where only the true scene holds
 // the occluder, and the gathered one-bounce irradiance of a grey floor beside a white wall under
-// one point light against a fine quadrature of the wall's radiance.
+// one point light against a fine quadrature of the wall's radiance, per voxel and pooled over
+// its neighbours.
 #include "reflectance/light_transport.h"
 
 #include <gtest/gtest.h>
@@ -256,63 +257,134 @@ double wall_irradiance(const Eigen::Vector3d& p, WallRadiance wall) {
   return sum * kCell * kCell;
 }
 
-TEST(LightTransport, GatheredIndirectIrradianceOfAFloorBesideAWhiteWallMatchesAQuadrature) {
-  // A white wall (x = 0) standing on a grey floor (y = 0) under one point light; both
-  // Lambertian, so the wall sends L = kd / pi * I cos / r^2 every way: the observed radiance the
-  // floor's voxels gather. The scene is seen once, from a camera that sees the whole wall face.
-  const render::PointLight light = light_at({0.5, 0.8, 0.0});
-  const auto direct = [&](const Eigen::Vector3d& point, const Eigen::Vector3d& normal) {
-    const Eigen::Vector3d to_light = light.position - point;
+// A white wall (x = 0) standing on a grey floor (y = 0) under one point light; both Lambertian,
+// so the wall sends L = kd / pi * I cos / r^2 every way: the observed radiance the floor's voxels
+// gather. The scene is seen once, from a camera that sees the whole wall face, then in a narrow
+// view of the floor 11-49 cm from the wall: its voxels are the ones gathered for.
+class WallBesideFloor {
+ public:
+  WallBesideFloor()
+      : light_(light_at({0.5, 0.8, 0.0})),
+        scene_({Box{{-0.2, -0.2, -0.4}, {0, 0.6, 0.4}}, Box{{-0.2, -0.2, -0.4}, {0.8, 0, 0.4}}},
+               [this](const Eigen::Vector3d& point, const Eigen::Vector3d& normal) {
+                 const double kd = normal.x() > 0.5 ? 0.9 : normal.y() > 0.5 ? 0.3 : 0;
+                 return Eigen::Vector3f::Constant(float(kd / M_PI * direct(point, normal)));
+               }) {
+    scene_.see(render::look_at({2.0, 1.0, 0.0}, {0.3, 0.2, 0.0}), kWideCamera, 0);
+    scene_.see(render::look_at({0.9, 0.6, 0.0}, {0.3, 0.0, 0.0}),
+               {64, 48, 200.0, 200.0, 31.5, 23.5}, 1);
+  }
+  // The gather's estimates after one frame with `params`.
+  LightTransport gather(const LightTransportParams& params) const {
+    LightTransport transport(params, scene_.grid().voxel_pool_size());
+    const fusion::BlockOccupancy occupancy(scene_.geometry());
+    transport.update_indirect(scene_.grid(), scene_.geometry(), occupancy, {light_}, 0);
+    return transport;
+  }
+  // The floor voxels 15-45 cm from the wall, within 5 cm of its middle.
+  std::vector<int> floor_voxels() const {
+    std::vector<int> voxels;
+    for (const VisibleVoxel& seen : scene_.grid().visible()) {
+      const Eigen::Vector3f p = scene_.grid().position(seen.voxel);
+      if (scene_.grid().has_surface(seen.voxel) && std::abs(p.y()) <= 0.005f && p.x() >= 0.15f &&
+          p.x() <= 0.45f && std::abs(p.z()) <= 0.05f)
+        voxels.push_back(seen.voxel);
+    }
+    return voxels;
+  }
+  const Eigen::Vector3f& position(int v) const { return scene_.grid().position(v); }
+  int any_voxel() const { return scene_.grid().visible().front().voxel; }
+  // The wall's irradiance at floor point p, by quadrature.
+  double expected(const Eigen::Vector3f& p) const {
+    return wall_irradiance(p.cast<double>(), [&](const Eigen::Vector3d& w) {
+      return 0.9 / M_PI * direct(w, Eigen::Vector3d::UnitX());
+    });
+  }
+
+ private:
+  double direct(const Eigen::Vector3d& point, const Eigen::Vector3d& normal) const {
+    const Eigen::Vector3d to_light = light_.position - point;
     return std::max(0.0, normal.dot(to_light.normalized())) / to_light.squaredNorm();
-  };
-  const auto wall_radiance = [&](const Eigen::Vector3d& w) {
-    return 0.9 / M_PI * direct(w, Eigen::Vector3d::UnitX());
-  };
-  const Box wall{{-0.2, -0.2, -0.4}, {0, 0.6, 0.4}}, floor{{-0.2, -0.2, -0.4}, {0.8, 0, 0.4}};
-  BoxScene scene({wall, floor}, [&](const Eigen::Vector3d& point, const Eigen::Vector3d& normal) {
-    const double kd = normal.x() > 0.5 ? 0.9 : normal.y() > 0.5 ? 0.3 : 0;
-    return Eigen::Vector3f::Constant(float(kd / M_PI * direct(point, normal)));
-  });
-  scene.see(render::look_at({2.0, 1.0, 0.0}, {0.3, 0.2, 0.0}), kWideCamera, 0);
-  // Then a narrow view of the floor 11-49 cm from the wall: its voxels are the ones gathered for.
-  scene.see(render::look_at({0.9, 0.6, 0.0}, {0.3, 0.0, 0.0}), {64, 48, 200.0, 200.0, 31.5, 23.5},
-            1);
-  const std::vector<render::PointLight> lights{light};
+  }
+  render::PointLight light_;
+  BoxScene scene_;
+};
+
+TEST(LightTransport, GatheredIndirectIrradianceOfAFloorBesideAWhiteWallMatchesAQuadrature) {
+  const WallBesideFloor scene;
   LightTransportParams params{.shadows = false, .indirect = true, .indirect_rays = 4096};
   params.indirect_rays_per_frame = params.indirect_rays;
   params.indirect_every_frames = 1;
-  LightTransport transport(params, scene.grid().voxel_pool_size());
-  const fusion::BlockOccupancy occupancy(scene.geometry());
-  transport.update_indirect(scene.grid(), scene.geometry(), occupancy, lights, 0);
-
-  // Floor voxels 15-45 cm from the wall, within 5 cm of its middle. Tolerance: the estimate's
-  // relative standard error with 4096 cosine-weighted rays, of which about a third meet the
-  // wall, is about 2 % (less with the low-discrepancy directions); each hit takes the radiance
-  // of the 2 cm voxel it lands in, which differs from the radiance at the hit by up to ~4 %
-  // where the wall's irradiance varies fastest; the rays start 1 cm above the floor. 5 % per
-  // voxel, 2 % on their mean.
-  double sum_ratio = 0;
-  int tested = 0;
-  for (const VisibleVoxel& seen : scene.grid().visible()) {
-    const int v = seen.voxel;
-    const Eigen::Vector3f p = scene.grid().position(v);
-    if (!scene.grid().has_surface(v) || std::abs(p.y()) > 0.005f || p.x() < 0.15f ||
-        p.x() > 0.45f || std::abs(p.z()) > 0.05f)
-      continue;
-    ASSERT_EQ(transport.indirect_rays(v), params.indirect_rays) << p.transpose();
-    const double expected = wall_irradiance(p.cast<double>(), wall_radiance);
-    const Eigen::Vector3f gathered = transport.lighting(v).indirect;
-    EXPECT_NEAR(gathered.x(), expected, 0.05 * expected) << p.transpose();
-    EXPECT_FLOAT_EQ(gathered.x(), gathered.z());  // grey light on grey surfaces
-    sum_ratio += gathered.x() / expected;
-    ++tested;
+  // Each voxel's own estimate, and the pooled one (the default), which averages it with its
+  // neighbours' on the floor: the irradiance is close to linear over 2 cm, so the pool's mean
+  // stays on the voxel's.
+  for (const bool pooling : {false, true}) {
+    params.indirect_pooling = pooling;
+    const LightTransport transport = scene.gather(params);
+    // Tolerance: the estimate's relative standard error with 4096 cosine-weighted rays, of which
+    // about a third meet the wall, is about 2 % (less with the low-discrepancy directions); each
+    // hit takes the radiance of the 2 cm voxel it lands in, which differs from the radiance at
+    // the hit by up to ~4 % where the wall's irradiance varies fastest; the rays start 1 cm above
+    // the floor. 5 % per voxel, 2 % on their mean.
+    double sum_ratio = 0;
+    const std::vector<int> voxels = scene.floor_voxels();
+    ASSERT_GT(voxels.size(), 20u);
+    for (const int v : voxels) {
+      const Eigen::Vector3f p = scene.position(v);
+      ASSERT_EQ(transport.indirect_rays(v), params.indirect_rays) << p.transpose();
+      const double expected = scene.expected(p);
+      const Eigen::Vector3f gathered = transport.lighting(v).indirect;
+      EXPECT_NEAR(gathered.x(), expected, 0.05 * expected) << p.transpose() << " " << pooling;
+      EXPECT_FLOAT_EQ(gathered.x(), gathered.z());  // grey light on grey surfaces
+      sum_ratio += gathered.x() / expected;
+    }
+    EXPECT_NEAR(sum_ratio / double(voxels.size()), 1.0, 0.02) << pooling;
   }
-  ASSERT_GT(tested, 20);
-  EXPECT_NEAR(sum_ratio / tested, 1.0, 0.02);
 
   // Off: no indirect light.
-  LightTransport off({.shadows = false, .indirect = false}, scene.grid().voxel_pool_size());
-  EXPECT_TRUE(off.lighting(scene.grid().visible().front().voxel).indirect.isZero());
+  LightTransport off({.shadows = false, .indirect = false}, 16);
+  EXPECT_TRUE(off.lighting(scene.any_voxel()).indirect.isZero());
+}
+
+TEST(LightTransport, APooledEstimateHasLightBeforeItsVoxelHasEnoughRaysOfItsOwn) {
+  // 4 rays per voxel, fewer than the 8 an estimate needs: alone, no voxel counts indirect light
+  // yet; pooled with its neighbours on the floor (9 of them at most, the rays of a 2 cm square
+  // around it), every one does, and near the quadrature. Tolerance: about 36 rays with a third
+  // on the wall scatter by about a fifth per voxel; the mean over the 20+ voxels by 5 %, 10 %
+  // with the hit voxels' radiance as above.
+  const WallBesideFloor scene;
+  LightTransportParams params{.shadows = false, .indirect = true, .indirect_rays_per_frame = 4};
+  params.indirect_every_frames = 1;
+  params.indirect_pooling = false;
+  const LightTransport alone = scene.gather(params);
+  params.indirect_pooling = true;
+  const LightTransport pooled = scene.gather(params);
+  double sum_ratio = 0;
+  const std::vector<int> voxels = scene.floor_voxels();
+  ASSERT_GT(voxels.size(), 20u);
+  for (const int v : voxels) {
+    ASSERT_EQ(alone.indirect_rays(v), 4);
+    EXPECT_TRUE(alone.lighting(v).indirect.isZero());
+    const float gathered = pooled.lighting(v).indirect.x();
+    EXPECT_GT(gathered, 0.0f) << scene.position(v).transpose();
+    sum_ratio += gathered / scene.expected(scene.position(v));
+  }
+  EXPECT_NEAR(sum_ratio / double(voxels.size()), 1.0, 0.1);
+}
+
+TEST(LightTransport, RaysArePooledOnlyAlongTheSameSurface) {
+  const float voxel = 0.02f;
+  const Eigen::Vector3f p(0, 0, 0), up = Eigen::Vector3f::UnitY();
+  // A floor neighbour, also on a gentle (20 degree) bend.
+  EXPECT_TRUE(pools_indirect_rays(p, up, {0.02f, 0.002f, 0}, up, voxel));
+  const float bend = 20 * float(M_PI) / 180;
+  EXPECT_TRUE(
+      pools_indirect_rays(p, up, {0.02f, 0.007f, 0}, {-std::sin(bend), std::cos(bend), 0}, voxel));
+  // A wall meeting the floor (a crease): its irradiance is another's.
+  EXPECT_FALSE(pools_indirect_rays(p, up, {0.02f, 0.01f, 0}, Eigen::Vector3f::UnitX(), voxel));
+  // The far side of a thin board, and a parallel surface 2 cm above (a step).
+  EXPECT_FALSE(pools_indirect_rays(p, up, {0.0f, -0.008f, 0}, -up, voxel));
+  EXPECT_FALSE(pools_indirect_rays(p, up, {0.02f, 0.02f, 0}, up, voxel));
 }
 
 TEST(LightTransport, RejectsBadParameters) {
