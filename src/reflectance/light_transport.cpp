@@ -374,33 +374,29 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
 }
 
 void LightTransport::estimate_indirect(const ObservationGrid& grid) {
-  const int min_rays = params_.indirect_min_rays;
-  if (!params_.indirect_pooling) {
-    for (const int v : due_) {
-      indirect_estimated_[v] = indirect_rays_[v] >= min_rays && indirect_rays_[v] > 0;
-      if (indirect_estimated_[v])
-        indirect_[v] = indirect_sum_[v] * (float(M_PI) / float(indirect_rays_[v]));
-    }
-    return;
-  }
   const float voxel_size = float(grid.params().voxel_size_m);
   parallel_for_chunks(due_.size(), 64, [&](std::size_t begin, std::size_t end) {
     ObservationGrid::BlockCache blocks;
-    std::array<int, 27> around;
+    std::array<int, 27> pool;  // the voxel alone, or its 3x3x3 neighbourhood
     for (std::size_t i = begin; i < end; ++i) {
       const int v = due_[i];
-      grid.find_voxels(grid.voxel_coordinates(v) - Eigen::Vector3i::Ones(), 3, around.data(),
-                       &blocks);
+      pool[0] = v;
+      const int size = params_.indirect_pooling ? 27 : 1;
+      if (params_.indirect_pooling)
+        grid.find_voxels(grid.voxel_coordinates(v) - Eigen::Vector3i::Ones(), 3, pool.data(),
+                         &blocks);
       Eigen::Vector3f sum = Eigen::Vector3f::Zero();
       int rays = 0;
-      for (const int u : around)
+      for (int k = 0; k < size; ++k) {
+        const int u = pool[std::size_t(k)];
         if (u >= 0 && indirect_rays_[u] > 0 && grid.has_surface(u) &&
             pools_indirect_rays(grid.position(v), grid.normal(v), grid.position(u), grid.normal(u),
                                 voxel_size)) {
           sum += indirect_sum_[u];
           rays += indirect_rays_[u];
         }
-      indirect_estimated_[v] = rays >= min_rays && rays > 0;
+      }
+      indirect_estimated_[v] = rays >= params_.indirect_min_rays && rays > 0;
       if (indirect_estimated_[v]) indirect_[v] = sum * (float(M_PI) / float(rays));
     }
   });
