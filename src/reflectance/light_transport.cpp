@@ -375,23 +375,24 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
 
 void LightTransport::estimate_indirect(const ObservationGrid& grid) {
   const float voxel_size = float(grid.params().voxel_size_m);
+  const int pool_size = params_.indirect_pooling ? 27 : 1;
   parallel_for_chunks(due_.size(), 64, [&](std::size_t begin, std::size_t end) {
     ObservationGrid::BlockCache blocks;
     std::array<int, 27> pool;  // the voxel alone, or its 3x3x3 neighbourhood
     for (std::size_t i = begin; i < end; ++i) {
       const int v = due_[i];
       pool[0] = v;
-      const int size = params_.indirect_pooling ? 27 : 1;
       if (params_.indirect_pooling)
         grid.find_voxels(grid.voxel_coordinates(v) - Eigen::Vector3i::Ones(), 3, pool.data(),
                          &blocks);
+      const Eigen::Vector3f& p_v = grid.position(v);
+      const Eigen::Vector3f& n_v = grid.normal(v);
       Eigen::Vector3f sum = Eigen::Vector3f::Zero();
       int rays = 0;
-      for (int k = 0; k < size; ++k) {
+      for (int k = 0; k < pool_size; ++k) {
         const int u = pool[std::size_t(k)];
         if (u >= 0 && indirect_rays_[u] > 0 && grid.has_surface(u) &&
-            pools_indirect_rays(grid.position(v), grid.normal(v), grid.position(u), grid.normal(u),
-                                voxel_size)) {
+            pools_indirect_rays(p_v, n_v, grid.position(u), grid.normal(u), voxel_size)) {
           sum += indirect_sum_[u];
           rays += indirect_rays_[u];
         }

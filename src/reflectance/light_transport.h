@@ -80,9 +80,8 @@ struct LightTransportParams {
   // A voxel whose estimate holds fewer rays than this counts no indirect light yet (too noisy).
   int indirect_min_rays = 8;
   // A voxel's estimate pools the rays of the voxels of its 3x3x3 neighbourhood on the same
-  // surface (pools_indirect_rays()). Without it a voxel seen in every frame waited 16 frames for
-  // its 8 rays, and the refined albedo of a rendering with bounced light was 2 dB worse
-  // (docs/decisions.md, "The gather pools its neighbours' rays").
+  // surface (pools_indirect_rays()): on its own rays alone a voxel seen every frame needs 16
+  // frames to reach indirect_min_rays (docs/decisions.md, "The gather pools its neighbours' rays").
   bool indirect_pooling = true;
   float indirect_max_distance_m = 10;
   // A hit voxel whose median observation reaches this radiance in a channel has clipped: a lamp
