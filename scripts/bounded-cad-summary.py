@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Markdown tables of scripts/eval-bounded-cad.sh's reports: median MCC per method, the three
-training seeds as their median and range.
+"""Markdown tables of scripts/eval-bounded-cad.sh's reports: median MCC per method, the seeds of
+each recipe (bounded-3c-s1..3, bounded-3c-gated-s1..3) as their median and range.
 
     bounded-cad-summary.py WORK
 """
@@ -13,17 +13,17 @@ import sys
 
 def row(report):
     summary = json.loads(report.read_text())["summary"]
-    seeds, cells = [], {}
+    seeds, cells = {}, {}
     for name, s in summary.items():
         mcc = s["median"]["mcc"]
         name = name.removeprefix("glint:")
-        if re.search(r"-s\d+$", name):
-            seeds.append(mcc)
+        if seed := re.search(r"-s\d+$", name):  # the seeds of one recipe share a column
+            seeds.setdefault(name[:seed.start()], []).append(mcc)
         else:
             cells[name] = f"{mcc:.3f}"
-    if seeds:
-        cells["new (3 seeds)"] = (f"{statistics.median(seeds):.3f} "
-                                  f"({min(seeds):.3f}-{max(seeds):.3f})")
+    for recipe, values in seeds.items():
+        cells[f"{recipe} ({len(values)} seeds)"] = (
+            f"{statistics.median(values):.3f} ({min(values):.3f}-{max(values):.3f})")
     return cells
 
 

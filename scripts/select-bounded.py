@@ -11,20 +11,16 @@ Writes WORK/selection.json.
 import json
 import pathlib
 import shutil
-import subprocess
 import sys
+
+from bounded_eval import run_eval
 
 MARGIN = 0.02  # the new model must beat the old one's validation score by this much
 TIE = 0.005    # seeds closer than this are split by the training validation split's edge F1
 
 
 def median_mcc(glint, folder, task, models, report):
-    if not report.exists():
-        subprocess.run(["nice", "-n", "10", glint, "--quiet", "edges", "eval", str(folder),
-                        "--task", task, "--no-baseline", "--report", str(report)]
-                       + [a for m in models for a in ("--model", str(m))],
-                       check=True, stdout=subprocess.DEVNULL)
-    summary = json.loads(report.read_text())["summary"]
+    summary = run_eval(glint, folder, task, models, report)["summary"]
     return {name.removeprefix("glint:"): s["median"]["mcc"] for name, s in summary.items()}
 
 

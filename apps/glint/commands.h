@@ -21,6 +21,7 @@ void register_edges_train(CLI::App& edges);
 void register_edges_synth(CLI::App& edges);
 void register_edges_eval(CLI::App& edges);
 void register_edges_label(CLI::App& edges);
+void register_edges_gate(CLI::App& edges);
 
 void register_denoise_commands(CLI::App& app);
 

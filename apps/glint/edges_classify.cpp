@@ -1,4 +1,5 @@
 // glint edges classify: per-point non-edge / sharp-edge / boundary labels for one cloud.
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -50,6 +51,18 @@ bool is_las(const std::string& path) {
   return extension == ".las" || extension == ".laz";
 }
 
+// What the noise gate of a gated model chose, for the log and the report (null otherwise).
+nlohmann::json gate_entry(const edges::Model& model, std::uint64_t quiet, std::uint64_t points,
+                          bool low_noise) {
+  if (!model.gated()) return nullptr;
+  log().info("noise gate: {:.1f} % of the points below {} -> the {} network answers",
+             100.0 * double(quiet) / double(std::max<std::uint64_t>(points, 1)),
+             model.noise_threshold, low_noise ? "low-noise" : "noisy");
+  return {{"threshold", model.noise_threshold},
+          {"quiet_points", quiet},
+          {"network", low_noise ? "low-noise" : "noisy"}};
+}
+
 // LAS in, LAS out: streamed, tiled when the cloud exceeds the memory limit, spread over the
 // ranks of mpirun when built with MPI.
 void run_classify_las(const ClassifyOptions& options) {
@@ -87,6 +100,8 @@ void run_classify_las(const ClassifyOptions& options) {
                  e.what());
     world.abort(1);
   }
+  const nlohmann::json gate =
+      gate_entry(model, stats.quiet_points, stats.points, stats.low_noise_network);
   if (world.size() > 1) {
     fmt::print(
         "rank {}/{}: {} tiles, {} points classified in {:.2f} s (read {:.2f} s, write "
@@ -126,6 +141,7 @@ void run_classify_las(const ClassifyOptions& options) {
                     {"tile_side_m", stats.tile_side_m},
                     {"halo_m_max", stats.halo_m_max},
                     {"halo_points", stats.halo_points},
+                    {"noise_gate", gate},
                     {"timings_s",
                      {{"read", stats.read_s},
                       {"classify", stats.classify_s},
@@ -153,6 +169,10 @@ void run_classify(const ClassifyOptions& options) {
   } catch (const Error& e) {
     throw Error(options.input, e.element(), e.reason());
   }
+  const nlohmann::json gate =
+      options.method == "angle-gap"
+          ? nlohmann::json(nullptr)
+          : gate_entry(model, result.quiet_points, cloud.size(), result.low_noise_network);
   edges::attach_classification(cloud, result);
   // The picture is made before any file is written, and a failure writing it takes the PLY
   // back: the command leaves both outputs or neither.
@@ -190,6 +210,7 @@ void run_classify(const ClassifyOptions& options) {
          {"scales", options.scales.empty() ? model.config.scales : options.scales},
          {"points", cloud.size()},
          {"labels", {{"non_edge", counts[0]}, {"sharp", counts[1]}, {"boundary", counts[2]}}},
+         {"noise_gate", gate},
          {"timings_s",
           {{"features", result.features_s}, {"network", result.inference_s}, {"total", total_s}}},
          {"points_per_s", double(cloud.size()) / total_s}});

@@ -15,6 +15,7 @@ void register_edges_commands(CLI::App& app) {
   register_edges_synth(*edges);
   register_edges_eval(*edges);
   register_edges_label(*edges);
+  register_edges_gate(*edges);
 }
 
 }  // namespace glint::app

@@ -27,23 +27,32 @@ void keep_probabilities(Classification& result, std::size_t point, const float* 
   if (classes > 2) result.p_boundary[point] = p[2];
 }
 
-}  // namespace
-
-Classification classify(const PointCloud& cloud, const Model& model,
-                        const std::vector<int>& scales) {
-  FeatureParams params;
-  params.scales = scales.empty() ? model.config.scales : scales;
-  if (params.scales.size() != model.config.scales.size()) {
+std::vector<int> scales_for(const Model& model, const std::vector<int>& scales) {
+  if (!scales.empty() && scales.size() != model.config.scales.size()) {
     throw Error("", "--scales",
                 "the model was trained on " + std::to_string(model.config.scales.size()) +
-                    " scales; got " + std::to_string(params.scales.size()));
+                    " scales; got " + std::to_string(scales.size()));
   }
-  model.check();
-  const std::size_t classes = static_cast<std::size_t>(model.config.classes);
-  Classification result = sized_result(cloud.size());
+  return scales.empty() ? model.config.scales : scales;
+}
 
-  // The network runs on each block of features as it is computed, so the rows are never all
-  // stored; each thread's time is split between the two stages to report them apart.
+// Computes the features once and runs every network on each block of them as it is computed,
+// so the rows are never all stored; one result per network. With `quiet`, also marks the points
+// whose noise statistic is below `threshold`. Each thread's time is split between the two
+// stages to report them apart.
+std::vector<Classification> run_networks(const PointCloud& cloud,
+                                         const std::vector<const Model*>& networks,
+                                         const std::vector<int>& scales, float threshold,
+                                         std::vector<std::uint8_t>* quiet) {
+  FeatureParams params;
+  params.scales = scales;
+  const int scale_count = static_cast<int>(scales.size());
+  const std::size_t row_size = std::size_t(scale_count) * kFeaturesPerScale;
+  const std::size_t classes = static_cast<std::size_t>(networks.front()->config.classes);
+  std::vector<Classification> results;
+  for (std::size_t n = 0; n < networks.size(); ++n) results.push_back(sized_result(cloud.size()));
+  if (quiet) quiet->assign(cloud.size(), 0);
+
   struct Worker {
     Model::PredictScratch scratch;
     std::vector<float> probabilities;
@@ -62,28 +71,80 @@ Classification classify(const PointCloud& cloud, const Model& model,
       [&](const std::uint32_t* points, const float* rows, std::size_t count) {
         Worker& worker = workers.local();
         const Stopwatch network_watch;
-        model.predict_rows(rows, count, worker.probabilities.data(), worker.labels.data(),
-                           worker.scratch);
-        for (std::size_t b = 0; b < count; ++b) {
-          result.labels[points[b]] = worker.labels[b];
-          keep_probabilities(result, points[b], worker.probabilities.data() + b * classes, classes);
+        for (std::size_t n = 0; n < networks.size(); ++n) {
+          networks[n]->predict_rows(rows, count, worker.probabilities.data(), worker.labels.data(),
+                                    worker.scratch);
+          Classification& result = results[n];
+          for (std::size_t b = 0; b < count; ++b) {
+            result.labels[points[b]] = worker.labels[b];
+            keep_probabilities(result, points[b], worker.probabilities.data() + b * classes,
+                               classes);
+          }
         }
+        if (quiet)
+          for (std::size_t b = 0; b < count; ++b)
+            (*quiet)[points[b]] = noise_statistic(rows + b * row_size, scale_count) < threshold;
         worker.network_s += network_watch.elapsed_s();
       });
   const double total_s = watch.elapsed_s();
   double network_s = 0;
   for (const Worker& worker : workers) network_s += worker.network_s;
   const double thread_s = total_s * double(std::max<std::size_t>(1, workers.size()));
-  result.inference_s = total_s * std::min(1.0, network_s / thread_s);
-  result.features_s = total_s - result.inference_s;
+  for (Classification& result : results) {
+    result.inference_s = total_s * std::min(1.0, network_s / thread_s);
+    result.features_s = total_s - result.inference_s;
+  }
+  return results;
+}
+
+std::uint64_t count_quiet(const std::vector<std::uint8_t>& quiet) {
+  return static_cast<std::uint64_t>(std::count(quiet.begin(), quiet.end(), std::uint8_t(1)));
+}
+
+}  // namespace
+
+GatedClassification classify_gated(const PointCloud& cloud, const Model& model,
+                                   const std::vector<int>& scales) {
+  if (!model.gated()) throw Error("model", "noise_gate", "the model has no noise gate");
+  model.check();
+  GatedClassification result;
+  std::vector<Classification> both =
+      run_networks(cloud, {&model, model.low_noise.get()}, scales_for(model, scales),
+                   model.noise_threshold, &result.quiet);
+  result.noisy = std::move(both[0]);
+  result.low_noise = std::move(both[1]);
+  return result;
+}
+
+Classification classify(const PointCloud& cloud, const Model& model,
+                        const std::vector<int>& scales) {
+  if (!model.gated()) {
+    model.check();
+    return std::move(run_networks(cloud, {&model}, scales_for(model, scales), 0, nullptr)[0]);
+  }
+  GatedClassification both = classify_gated(cloud, model, scales);
+  const std::uint64_t quiet = count_quiet(both.quiet);
+  const bool low_noise = Model::low_noise_answers(quiet, cloud.size());
+  Classification result = std::move(low_noise ? both.low_noise : both.noisy);
+  result.quiet_points = quiet;
+  result.low_noise_network = low_noise;
   return result;
 }
 
 Classification classify_features(const FeatureMatrix& features, const Model& model) {
   Classification result = sized_result(features.points);
+  const Model* network = &model;
+  if (model.gated()) {
+    model.check_features(features);
+    for (std::size_t i = 0; i < features.points; ++i)
+      result.quiet_points +=
+          noise_statistic(features.row(i), features.scales) < model.noise_threshold;
+    result.low_noise_network = Model::low_noise_answers(result.quiet_points, features.points);
+    if (result.low_noise_network) network = model.low_noise.get();
+  }
   const Stopwatch watch;
   std::vector<float> probabilities;
-  model.predict(features, probabilities, result.labels);
+  network->predict(features, probabilities, result.labels);
   result.inference_s = watch.elapsed_s();
 
   const std::size_t classes = static_cast<std::size_t>(model.config.classes);

@@ -269,6 +269,12 @@ PointKernel point_kernel() {
 
 }  // namespace
 
+float noise_statistic(const float* row, int scales) {
+  const float* smallest = row + (scales - 1) * kFeaturesPerScale;
+  // Rounding can leave a flat subset's smallest eigenvalue slightly negative.
+  return std::sqrt(std::max(0.0f, smallest[2] + smallest[5]));
+}
+
 void check_scales(const std::vector<int>& scales) {
   if (scales.empty()) throw Error("", "scales", "at least one scale is needed");
   for (std::size_t s = 0; s < scales.size(); ++s) {

@@ -64,6 +64,13 @@ using FeatureBlockConsumer =
 void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& params,
                                 std::size_t block_size, const FeatureBlockConsumer& consume);
 
+// The noise statistic of one point, from its feature row (`scales` scales): at the smallest
+// scale, sqrt(sigma_upper(3) + sigma_lower(3)), the spread of the two half-neighbourhoods off
+// their own planes in the eq. (5.4) frame. Near 0 on clean surfaces away from edges; it grows
+// with displacement noise relative to the point spacing. The noise gate of edges/model.h
+// counts the points where it is below a threshold.
+float noise_statistic(const float* row, int scales);
+
 // Validates scales (>= 6, strictly decreasing); throws glint::Error naming the problem.
 void check_scales(const std::vector<int>& scales);
 

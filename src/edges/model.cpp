@@ -137,31 +137,109 @@ void Model::check() const {
                   fmt::format("expected {} x {} weights and {} biases", shape.outputs, shape.inputs,
                               shape.outputs));
   }
+  if (gated()) {
+    if (low_noise->gated()) throw Error(where, "noise_gate", "the gate's network has a gate");
+    if (low_noise->config.classes != config.classes || low_noise->config.scales != config.scales ||
+        low_noise->layers.size() != layers.size())
+      throw Error(where, "noise_gate.low_noise",
+                  "the gate's network must have the same classes, scales and layers");
+    low_noise->check();
+    if (!std::isfinite(noise_threshold) || noise_threshold <= 0.0f)
+      throw Error(where, "noise_gate.threshold",
+                  fmt::format("must be finite and > 0, got {}", noise_threshold));
+  }
 }
 
-nlohmann::json Model::to_json() const {
-  check();
+Model Model::with_noise_gate(Model low_noise_network, float threshold) const {
+  if (gated()) throw Error("model", "noise_gate", "already has a noise gate");
+  Model gated_model = *this;
+  gated_model.low_noise = std::make_shared<const Model>(std::move(low_noise_network));
+  gated_model.noise_threshold = threshold;
+  gated_model.check();
+  return gated_model;
+}
+
+namespace {
+
+// The keys of one network: standardisation, layers, parameter count, training record.
+nlohmann::json network_json(const Model& model) {
   nlohmann::json layer_array = nlohmann::json::array();
-  for (const DenseLayer& layer : layers)
+  for (const DenseLayer& layer : model.layers)
     layer_array.push_back({{"name", layer.name},
                            {"inputs", layer.inputs},
                            {"outputs", layer.outputs},
                            {"weights", io::exact_float_array(layer.weights)},
                            {"bias", io::exact_float_array(layer.bias)}});
-  return {{"format", kFormatName},
-          {"version", kFormatVersion},
-          {"classes", class_names(config.classes)},
-          {"scales", config.scales},
-          {"features_per_scale", kFeaturesPerScale},
-          {"fusion_width", config.fusion_width},
-          {"hidden", config.hidden},
-          {"hidden_layers", config.hidden_layers},
-          {"leaky_slope", io::exact_float(config.leaky_slope)},
-          {"parameter_count", parameter_count()},
-          {"input_mean", io::exact_float_array(input_mean)},
-          {"input_std", io::exact_float_array(input_std)},
-          {"layers", layer_array},
-          {"training", training_info.is_null() ? nlohmann::json::object() : training_info}};
+  return {
+      {"parameter_count", model.parameter_count()},
+      {"input_mean", io::exact_float_array(model.input_mean)},
+      {"input_std", io::exact_float_array(model.input_std)},
+      {"layers", layer_array},
+      {"training", model.training_info.is_null() ? nlohmann::json::object() : model.training_info}};
+}
+
+// Reads network_json's keys of `object` (key path `where`) into `model`, whose config is set.
+void read_network(const io::JsonFields& reader, const nlohmann::json& object,
+                  const std::string& where, Model& model) {
+  const std::size_t columns = model.config.scales.size() * kFeaturesPerScale;
+  model.input_mean = reader.floats(object, "input_mean", columns, where);
+  model.input_std = reader.floats(object, "input_std", columns, where);
+  for (std::size_t c = 0; c < columns; ++c)
+    if (!(model.input_std[c] >= Model::kMinInputStd))
+      reader.fail(io::key_path(where, fmt::format("input_std[{}]", c)),
+                  fmt::format("must be >= {}", Model::kMinInputStd));
+
+  const nlohmann::json& layer_array = reader.member(object, "layers", where);
+  if (!layer_array.is_array() || layer_array.size() != model.layers.size())
+    reader.fail(io::key_path(where, "layers"),
+                fmt::format("expected an array of {} layers", model.layers.size()));
+  for (std::size_t l = 0; l < model.layers.size(); ++l) {
+    DenseLayer& layer = model.layers[l];
+    const nlohmann::json& entry = layer_array[l];
+    const std::string layer_key = io::key_path(where, fmt::format("layers[{}]", l));
+    if (!entry.is_object()) reader.fail(layer_key, "expected an object");
+    const nlohmann::json& name = reader.member(entry, "name", layer_key);
+    if (!name.is_string() || name.get<std::string>() != layer.name)
+      reader.fail(layer_key + ".name", fmt::format("expected \"{}\"", layer.name));
+    const nlohmann::json& inputs = reader.member(entry, "inputs", layer_key);
+    const nlohmann::json& outputs = reader.member(entry, "outputs", layer_key);
+    if (inputs != layer.inputs || outputs != layer.outputs)
+      reader.fail(layer_key,
+                  fmt::format("the config implies a {} x {} layer", layer.outputs, layer.inputs));
+    layer.weights = reader.floats(entry, "weights", layer.weights.size(), layer_key);
+    layer.bias = reader.floats(entry, "bias", layer.bias.size(), layer_key);
+  }
+
+  const nlohmann::json& count = reader.member(object, "parameter_count", where);
+  if (!count.is_number_unsigned() || count.get<std::size_t>() != model.parameter_count())
+    reader.fail(io::key_path(where, "parameter_count"),
+                fmt::format("the layers hold {} parameters", model.parameter_count()));
+
+  if (const auto training = object.find("training"); training != object.end()) {
+    if (!training->is_object()) reader.fail(io::key_path(where, "training"), "expected an object");
+    model.training_info = *training;
+  }
+}
+
+}  // namespace
+
+nlohmann::json Model::to_json() const {
+  check();
+  nlohmann::json root = {{"format", kFormatName},
+                         {"version", kFormatVersion},
+                         {"classes", class_names(config.classes)},
+                         {"scales", config.scales},
+                         {"features_per_scale", kFeaturesPerScale},
+                         {"fusion_width", config.fusion_width},
+                         {"hidden", config.hidden},
+                         {"hidden_layers", config.hidden_layers},
+                         {"leaky_slope", io::exact_float(config.leaky_slope)}};
+  root.update(network_json(*this));
+  if (gated())
+    root["noise_gate"] = {{"statistic", "sqrt(sigma_upper(3) + sigma_lower(3)), smallest scale"},
+                          {"threshold", io::exact_float(noise_threshold)},
+                          {"low_noise", network_json(*low_noise)}};
+  return root;
 }
 
 void Model::save(const std::string& path) const { io::write_json(path, to_json()); }
@@ -197,41 +275,17 @@ Model Model::load(const std::string& path) {
   }
 
   Model model(config);
-  const std::size_t columns = config.scales.size() * kFeaturesPerScale;
-  model.input_mean = reader.floats(root, "input_mean", columns);
-  model.input_std = reader.floats(root, "input_std", columns);
-  for (std::size_t c = 0; c < columns; ++c)
-    if (!(model.input_std[c] >= kMinInputStd))
-      reader.fail(fmt::format("input_std[{}]", c), fmt::format("must be >= {}", kMinInputStd));
-
-  const nlohmann::json& layer_array = reader.member(root, "layers");
-  if (!layer_array.is_array() || layer_array.size() != model.layers.size())
-    reader.fail("layers", fmt::format("expected an array of {} layers", model.layers.size()));
-  for (std::size_t l = 0; l < model.layers.size(); ++l) {
-    DenseLayer& layer = model.layers[l];
-    const nlohmann::json& entry = layer_array[l];
-    const std::string where = fmt::format("layers[{}]", l);
-    if (!entry.is_object()) reader.fail(where, "expected an object");
-    const nlohmann::json& name = reader.member(entry, "name", where);
-    if (!name.is_string() || name.get<std::string>() != layer.name)
-      reader.fail(where + ".name", fmt::format("expected \"{}\"", layer.name));
-    const nlohmann::json& inputs = reader.member(entry, "inputs", where);
-    const nlohmann::json& outputs = reader.member(entry, "outputs", where);
-    if (inputs != layer.inputs || outputs != layer.outputs)
-      reader.fail(where,
-                  fmt::format("the config implies a {} x {} layer", layer.outputs, layer.inputs));
-    layer.weights = reader.floats(entry, "weights", layer.weights.size(), where);
-    layer.bias = reader.floats(entry, "bias", layer.bias.size(), where);
-  }
-
-  const nlohmann::json& count = reader.member(root, "parameter_count");
-  if (!count.is_number_unsigned() || count.get<std::size_t>() != model.parameter_count())
-    reader.fail("parameter_count",
-                fmt::format("the layers hold {} parameters", model.parameter_count()));
-
-  if (const auto training = root.find("training"); training != root.end()) {
-    if (!training->is_object()) reader.fail("training", "expected an object");
-    model.training_info = *training;
+  read_network(reader, root, "", model);
+  if (const auto gate = root.find("noise_gate"); gate != root.end()) {
+    if (!gate->is_object()) reader.fail("noise_gate", "expected an object");
+    Model low_noise(config);
+    read_network(reader, reader.member(*gate, "low_noise", "noise_gate"), "noise_gate.low_noise",
+                 low_noise);
+    const float threshold = reader.finite_float(reader.member(*gate, "threshold", "noise_gate"),
+                                                "noise_gate.threshold");
+    if (!(threshold > 0.0f)) reader.fail("noise_gate.threshold", "must be > 0");
+    model.low_noise = std::make_shared<const Model>(std::move(low_noise));
+    model.noise_threshold = threshold;
   }
   return model;
 }

@@ -13,8 +13,14 @@
 // trainable parameters (the thesis's "1.6k"); with C = 2 it has 1,578.
 //
 // Classes: index = glint point label: 0 non-edge, 1 sharp edge, 2 boundary (C = 3 only).
+//
+// A model file may hold a noise gate: a second network of the same config, trained on clean
+// clouds, that answers a whole cloud instead of the first when more than half of the cloud's
+// points have a noise statistic (edges::noise_statistic) below the gate's threshold
+// (docs/edges.md, "The noise gate").
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -62,6 +68,19 @@ class Model {
   std::vector<DenseLayer> layers;  // see make_layers
   nlohmann::json training_info = nlohmann::json::object();  // free-form: how it was trained
 
+  // The noise gate (none when low_noise is null): low_noise has this config and no gate.
+  std::shared_ptr<const Model> low_noise;
+  float noise_threshold = 0;  // > 0, in units of edges::noise_statistic
+  bool gated() const { return low_noise != nullptr; }
+  // Whether the low-noise network answers a cloud of `points` points of which `quiet` have a
+  // noise statistic below the threshold: more than half of them.
+  static bool low_noise_answers(std::uint64_t quiet, std::uint64_t points) {
+    return 2 * quiet > points;
+  }
+  // This model with `low_noise` as its gate's network (checks that the configs match and the
+  // threshold is finite and > 0; throws glint::Error).
+  Model with_noise_gate(Model low_noise_network, float threshold) const;
+
   static constexpr float kMinInputStd = 1e-6f;
 
   // Reads and validates a model file (format, version, every key, array sizes, finite values,
@@ -72,10 +91,12 @@ class Model {
   void save(const std::string& path) const;
   nlohmann::json to_json() const;
 
-  // Trainable parameters (weights and biases; the fixed standardisation is not counted).
+  // Trainable parameters of this network (weights and biases; the fixed standardisation and the
+  // gate's network are not counted).
   std::size_t parameter_count() const;
 
-  // Throws glint::Error when the members are inconsistent (config, array sizes, shapes).
+  // Throws glint::Error when the members are inconsistent (config, array sizes, shapes, the
+  // gate's network and threshold).
   void check() const;
   // Throws glint::Error when the features do not fit the model (scale count, value count).
   void check_features(const FeatureMatrix& features) const;

@@ -30,6 +30,13 @@ constexpr std::uint64_t kMaxCountCells = 1ull << 23;
 constexpr std::uint64_t kFixedBytes = 400ull << 20;
 constexpr std::size_t kResultBytes = 9;  // label, p_sharp, p_boundary
 
+// One network's result of one point, as a tile file stores it.
+void put_result(const Classification& result, std::size_t i, std::uint8_t* record) {
+  record[0] = result.labels[i];
+  std::memcpy(record + 1, &result.p_sharp[i], 4);
+  std::memcpy(record + 5, &result.p_boundary[i], 4);
+}
+
 // A tile's point as stored in its bucket file.
 struct TilePoint {
   float x, y, z;
@@ -373,6 +380,8 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
     } catch (const Error& e) {
       throw Error(input, e.element(), e.reason());
     }
+    stats.quiet_points = result.quiet_points;
+    stats.low_noise_network = result.low_noise_network;
     stats.classify_s = watch.elapsed_s();
     cloud = PointCloud();
     watch.restart();
@@ -552,6 +561,7 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
 
   // Per tile: classify core and halo together, keep the core's results in input order.
   watch.restart();
+  const std::size_t record_bytes = model.gated() ? 2 * kResultBytes : kResultBytes;
   std::uint64_t rank_points = 0;
   for (const std::size_t t : mine) rank_points += tile_core[t];
   stats.rank_points = rank_points;
@@ -581,9 +591,15 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
                                 tile_total[t]));
       }
       set_quiet(true);  // one bar over all tiles, not one per tile
-      Classification result;
+      // A gated model's tile keeps both networks' results; the file's choice comes after the
+      // last tile.
+      GatedClassification result;
       try {
-        result = classify(cloud, model, scales);
+        if (model.gated()) {
+          result = classify_gated(cloud, model, scales);
+        } else {
+          result.noisy = classify(cloud, model, scales);
+        }
       } catch (const Error& e) {
         set_quiet(was_quiet);
         throw Error(input, e.element(), fmt::format("tile {}: {}", t, e.reason()));
@@ -593,11 +609,13 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
       File results(open_file(result_path, "wb", file_buffer));
       for (std::size_t i = 0; i < cloud.size(); ++i) {
         if (!core[i]) continue;
-        std::uint8_t record[kResultBytes];
-        record[0] = result.labels[i];
-        std::memcpy(record + 1, &result.p_sharp[i], 4);
-        std::memcpy(record + 5, &result.p_boundary[i], 4);
-        write_all(results.get(), record, kResultBytes, result_path.string());
+        std::uint8_t record[2 * kResultBytes];
+        put_result(result.noisy, i, record);
+        if (model.gated()) {
+          put_result(result.low_noise, i, record + kResultBytes);
+          stats.quiet_points += result.quiet[i];
+        }
+        write_all(results.get(), record, record_bytes, result_path.string());
       }
       if (std::fflush(results.get()) != 0) {
         throw Error(result_path.string(), "", "cannot write a temporary tile file");
@@ -609,6 +627,13 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
     progress.finish();
   }
   stats.classify_s = watch.elapsed_s();
+  if (model.gated()) {  // one choice of network for the whole file
+    std::vector<std::uint64_t> quiet{stats.quiet_points};
+    world.sum(quiet);
+    stats.quiet_points = quiet[0];
+    stats.low_noise_network = Model::low_noise_answers(stats.quiet_points, n);
+  }
+  const std::size_t result_offset = stats.low_noise_network ? kResultBytes : 0;
   world.barrier();
 
   // Pass 4: the output, in input order; each point takes the next result of its core tile.
@@ -623,7 +648,7 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
       file_buffers[t].resize(1 << 15);
       const std::filesystem::path path = folder.path / fmt::format("t{}.res", t);
       results[t].reset(open_file(path, "rb", file_buffers[t]));
-      if (::fseeko(results[t].get(), off_t(before * kResultBytes), SEEK_SET) != 0) {
+      if (::fseeko(results[t].get(), off_t(before * record_bytes), SEEK_SET) != 0) {
         throw Error(path.string(), "", "cannot seek in a temporary tile file");
       }
     }
@@ -635,15 +660,16 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
                                    std::int32_t xyz[3];
                                    io::las_record_xyz(record, xyz);
                                    const std::size_t t = core_tile(xyz);
-                                   std::uint8_t bytes[kResultBytes];
+                                   std::uint8_t bytes[2 * kResultBytes];
                                    if (!results[t] ||
-                                       std::fread(bytes, kResultBytes, 1, results[t].get()) != 1) {
+                                       std::fread(bytes, record_bytes, 1, results[t].get()) != 1) {
                                      throw Error(folder.path.string(), "",
                                                  fmt::format("tile {} has too few results", t));
                                    }
-                                   label = bytes[0];
-                                   std::memcpy(&p_sharp, bytes + 1, 4);
-                                   std::memcpy(&p_boundary, bytes + 5, 4);
+                                   const std::uint8_t* chosen = bytes + result_offset;
+                                   label = chosen[0];
+                                   std::memcpy(&p_sharp, chosen + 1, 4);
+                                   std::memcpy(&p_boundary, chosen + 5, 4);
                                  });
                    });
   }

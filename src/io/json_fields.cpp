@@ -9,13 +9,10 @@
 #include "io/json_report.h"
 
 namespace glint::io {
-namespace {
 
 std::string key_path(const std::string& where, const std::string& key) {
   return where.empty() ? key : where + "." + key;
 }
-
-}  // namespace
 
 nlohmann::json JsonFields::read_document(const std::string& format, int version) const {
   nlohmann::json root = read_json(path_);

@@ -8,6 +8,9 @@
 
 namespace glint::io {
 
+// The key path of `key` inside the object at key path `where` ("" at the top level).
+std::string key_path(const std::string& where, const std::string& key);
+
 class JsonFields {
  public:
   explicit JsonFields(std::string path) : path_(std::move(path)) {}

@@ -122,6 +122,41 @@ TEST_F(CliTest, BadInputsGiveOneLineAndNoOutput) {
   EXPECT_NE(run.output.find("truncated.ply"), std::string::npos) << run.output;
 }
 
+TEST_F(CliTest, GateJoinsTwoNetworksAndClassifyReportsItsChoice) {
+  const std::string models = std::string(GLINT_TEST_DATA_DIR) + "/../../models/";
+  const std::string three = models + "bounded-3c.json", two = models + "bounded-2c.json";
+  CommandResult run =
+      glint("edges gate " + three + " " + two + " --threshold 0.1 -o " + path("never.json"));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.output.find("bounded-2c.json"), std::string::npos) << run.output;
+  EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << run.output;
+  run = glint("edges gate " + three + " " + three + " --threshold 0 -o " + path("never.json"));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.output.find("--threshold"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(path("never.json")));
+
+  run = glint("edges gate " + three + " " + three + " --threshold 0.1 -o " + path("gated.json"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  run = glint("edges gate " + path("gated.json") + " " + three + " --threshold 0.1 -o " +
+              path("never.json"));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.output.find("already has a noise gate"), std::string::npos) << run.output;
+
+  run = glint("edges synth -o " + path("clouds") +
+              " --count 1 --seed 5 --min-points 1500 --max-points 2500 --shapes box --noise 0 "
+              "--outliers 0");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::string cloud;
+  for (const auto& entry : fs::directory_iterator(path("clouds")))
+    if (entry.path().extension() == ".ply") cloud = entry.path().string();
+  run = glint("edges classify " + cloud + " -o " + path("out.ply") + " --model " +
+              path("gated.json") + " --report " + path("classify.json"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const auto report = nlohmann::json::parse(std::ifstream(path("classify.json")));
+  EXPECT_EQ(report["noise_gate"]["network"], "low-noise") << report.dump();
+  EXPECT_EQ(report["noise_gate"]["threshold"], 0.1f);
+}
+
 // --png into a missing folder failed after OUT.ply was written, leaving it behind; now the
 // folder is made, and a --png that cannot be written is refused before anything is.
 TEST_F(CliTest, ClassifyWritesBothOutputsOrNeither) {

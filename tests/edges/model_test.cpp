@@ -252,8 +252,8 @@ TEST(ModelTest, SaveLoadRoundTripIsExact) {
 class MalformedModelTest : public ::testing::Test {
  protected:
   void expect_rejected(const std::function<void(nlohmann::json&)>& damage,
-                       const std::string& element) {
-    nlohmann::json json = random_model(ModelConfig{}, 3).to_json();
+                       const std::string& element,
+                       nlohmann::json json = random_model(ModelConfig{}, 3).to_json()) {
     damage(json);
     const std::string path = dir_.file("broken.json");
     std::ofstream(path) << json.dump();
@@ -298,6 +298,25 @@ TEST_F(MalformedModelTest, WrongValues) {
   expect_rejected([](nlohmann::json& j) { j["version"] = 2; }, "version");
   expect_rejected([](nlohmann::json& j) { j["classes"] = {"a", "b", "c"}; }, "classes");
   expect_rejected([](nlohmann::json& j) { j["training"] = 3; }, "training");
+}
+
+TEST_F(MalformedModelTest, BrokenNoiseGates) {
+  const nlohmann::json gated = random_model(ModelConfig{}, 3)
+                                   .with_noise_gate(random_model(ModelConfig{}, 4), 0.1f)
+                                   .to_json();
+  auto rejects = [&](auto damage, const std::string& element) {
+    expect_rejected(damage, element, gated);
+  };
+  rejects([](nlohmann::json& j) { j["noise_gate"] = 3; }, "noise_gate");
+  rejects([](nlohmann::json& j) { j["noise_gate"].erase("threshold"); }, "noise_gate.threshold");
+  rejects([](nlohmann::json& j) { j["noise_gate"]["threshold"] = -0.5; }, "noise_gate.threshold");
+  rejects([](nlohmann::json& j) { j["noise_gate"].erase("low_noise"); }, "noise_gate.low_noise");
+  rejects([](nlohmann::json& j) { j["noise_gate"]["low_noise"]["layers"][4].erase("bias"); },
+          "noise_gate.low_noise.layers[4].bias");
+  rejects([](nlohmann::json& j) { j["noise_gate"]["low_noise"]["input_std"][0] = 0.0; },
+          "noise_gate.low_noise.input_std[0]");
+  rejects([](nlohmann::json& j) { j["noise_gate"]["low_noise"]["parameter_count"] = 7; },
+          "noise_gate.low_noise.parameter_count");
 }
 
 TEST_F(MalformedModelTest, NotJsonOrNoFile) {

@@ -34,8 +34,9 @@ std::vector<std::uint8_t> file_bytes(const std::string& path) {
   return {std::istreambuf_iterator<char>(stream), {}};
 }
 
-// Three synthetic shapes 10 m apart on a ground strip, quantised to 0.1 mm, LAS 1.2 format 1.
-void write_scene(const std::string& path, const double offset[3]) {
+// Three synthetic shapes 10 m apart on a ground strip, quantised to 0.1 mm, LAS 1.2 format 1;
+// `noise` m of Gaussian noise on every coordinate.
+void write_scene(const std::string& path, const double offset[3], double noise = 0) {
   SynthParams synth;
   synth.seed = 4;
   synth.min_points = 2500;
@@ -60,6 +61,11 @@ void write_scene(const std::string& path, const double offset[3]) {
   std::mt19937_64 rng(9);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (int i = 0; i < 6000; ++i) points.push_back({-1 + 32 * u(rng), -1 + 4 * u(rng), -0.2});
+
+  std::normal_distribution<double> displacement(0.0, noise);
+  if (noise > 0)
+    for (auto& point : points)
+      for (double& coordinate : point) coordinate += displacement(rng);
 
   const double scale[3] = {1e-4, 1e-4, 1e-4};
   std::vector<std::uint8_t> records(points.size() * 28, 0);
@@ -151,6 +157,42 @@ TEST_F(TiledClassify, TilesGiveTheWholeCloudsLabelsPointForPoint) {
   const PointCloud out = io::read_las(path("tiled.las"));
   EXPECT_EQ((*out.get<std::uint8_t>("classification"))[0], 6);  // never overwritten
   EXPECT_EQ(out.get<std::uint8_t>("scalar_label")->size(), whole.points);
+}
+
+// A noise-gated model chooses one network for the whole file: in tiles the same one, from the
+// quiet points of every tile's core, as for the cloud at once.
+TEST_F(TiledClassify, AGatedModelChoosesOneNetworkForTheWholeFileInTilesToo) {
+  const double origin[3] = {0, 0, 0};
+  write_scene(path("scene.las"), origin);
+  Model low_noise = bounded_model();
+  low_noise.layers.back().bias[2] += 4.0f;  // a network that calls far more points boundary
+  const Model gated = bounded_model().with_noise_gate(low_noise, 0.1f);
+  const TiledClassifyStats whole = classify_las(path("scene.las"), path("whole.las"), gated);
+  EXPECT_TRUE(whole.low_noise_network);  // clean shapes on a flat ground
+  classify_las(path("scene.las"), path("alone.las"), low_noise);
+  const OutputDifference as_alone = compare_outputs(path("whole.las"), path("alone.las"));
+  EXPECT_EQ(as_alone.labels, 0u);
+  EXPECT_EQ(as_alone.probabilities, 0u);
+
+  TiledClassifyParams params;
+  params.tile_points = 9000;
+  const TiledClassifyStats tiled =
+      classify_las(path("scene.las"), path("tiled.las"), gated, params);
+  EXPECT_TRUE(tiled.tiled);
+  EXPECT_TRUE(tiled.low_noise_network);
+  EXPECT_NEAR(double(tiled.quiet_points), double(whole.quiet_points), whole.points / 100.0);
+  const OutputDifference difference = compare_outputs(path("whole.las"), path("tiled.las"));
+  EXPECT_TRUE(difference.other_bytes_equal);
+  EXPECT_EQ(difference.labels, 0u);
+
+  // A noisy scene: the noisy network, the ungated model's output.
+  write_scene(path("noisy-scene.las"), origin, 0.1);
+  const TiledClassifyStats noisy =
+      classify_las(path("noisy-scene.las"), path("noisy.las"), gated, params);
+  EXPECT_FALSE(noisy.low_noise_network);
+  classify_las(path("noisy-scene.las"), path("ungated.las"), bounded_model(), params);
+  EXPECT_EQ(compare_outputs(path("noisy.las"), path("ungated.las")).labels, 0u);
+  EXPECT_EQ(compare_outputs(path("noisy.las"), path("ungated.las")).probabilities, 0u);
 }
 
 TEST_F(TiledClassify, FarFromTheOriginClassifiesExactlyAsAtTheOrigin) {
