@@ -44,6 +44,31 @@ def test_classify_scales_and_model_options(cloud_file, cli, tmp_path):
     assert not probs[:, 1].any()  # a 2-class model has no boundary class
 
 
+def test_classify_takes_a_noise_gated_model(cli, tmp_path):
+    import json
+    from conftest import REPO
+    shipped = REPO / "models/bounded-3c.json"
+    # A second network that differs from the shipped one: more weight on the boundary class.
+    network = json.loads(shipped.read_text())
+    network["layers"][-1]["bias"][2] += 4.0
+    low_noise = tmp_path / "low-noise.json"
+    low_noise.write_text(json.dumps(network))
+    gated = tmp_path / "gated.json"
+    refused = cli("edges", "gate", shipped, REPO / "models/bounded-2c.json", "--threshold", "0.1",
+                  "-o", gated, check=False)
+    assert refused.returncode == 1 and "bounded-2c.json" in refused.stderr
+    cli("edges", "gate", shipped, low_noise, "--threshold", "0.1", "-o", gated)
+
+    # A clean plane: every point is quiet, so the low-noise network answers.
+    x, y = np.meshgrid(np.arange(60, dtype=np.float32), np.arange(60, dtype=np.float32))
+    plane = np.stack([x.ravel(), y.ravel(), np.zeros(x.size, np.float32)], axis=1)
+    labels, probs = glint.edges.classify(plane, model=gated)
+    expected_labels, expected_probs = glint.edges.classify(plane, model=low_noise)
+    np.testing.assert_array_equal(labels, expected_labels)
+    np.testing.assert_array_equal(probs, expected_probs)
+    assert not np.array_equal(probs, glint.edges.classify(plane, model=shipped)[1])
+
+
 def test_features_equal_cli(cloud_file, cli, tmp_path):
     out = tmp_path / "features.npy"
     cli("edges", "features", cloud_file, "-o", out, "--scales", "32,16")
