@@ -48,7 +48,7 @@ void register_edges_gate(CLI::App& edges) {
       "cloud when more than half of its points have a noise statistic below --threshold\n"
       "(sqrt(sigma_upper3 + sigma_lower3) at the smallest scale, see docs/edges.md), the noisy\n"
       "network answers every other cloud. Both need the same classes and scales.\n"
-      "Example: glint edges gate noisy-3c.json clean-3c.json --threshold 0.07 -o gated-3c.json");
+      "Example: glint edges gate noisy-3c.json clean-3c.json --threshold 0.01 -o gated-3c.json");
   command->add_option("noisy", options->noisy, "Model for noisy clouds (e.g. trained with noise)")
       ->required()
       ->check(CLI::ExistingFile);
