@@ -66,10 +66,10 @@ def main():
         shipped = trained / f"bounded-{classes}c-shipped.json"
         if not shipped.exists():
             shutil.copyfile(models_dir / f"bounded-{classes}c.json", shipped)
-        network = json.loads(shipped.read_text())
-        network.pop("noise_gate", None)
+        single = json.loads(shipped.read_text())
+        single.pop("noise_gate", None)
         noisy = trained / f"bounded-{classes}c-noisy.json"
-        noisy.write_text(json.dumps(network))
+        noisy.write_text(json.dumps(single))
         clean = sorted(trained.glob(f"bounded-{classes}c-clean-s*.json"))
         # The threshold is chosen once, on the 3-class pairs; the 2-class pairs take it.
         thresholds = THRESHOLDS if threshold is None else [threshold]

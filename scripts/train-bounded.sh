@@ -12,9 +12,8 @@
 # The procedural shapes of `glint edges synth` are left out: with them the CAD validation score
 # below was lower (docs/decisions.md, "BoundED trains on CAD-kernel parts, not procedural shapes").
 # Each model is trained with seeds 1, 2 and 3 (two trainings at a time), and so is a low-noise
-# network on the clean CAD clouds alone, for the noise gate; batches hold the
-# classes in equal numbers (--balance) and the non-edge decision offset is tuned on the 5 %
-# validation split. Which seed ships, and whether the new models replace the old ones, is decided
+# network on the clean CAD clouds alone, for the noise gate; batches hold the classes in equal
+# numbers (--balance) and the non-edge decision offset is tuned on the 5 % validation split. Which seed ships, and whether the new models replace the old ones, is decided
 # by scripts/select-bounded.py on the validation split and on a CAD validation set (seed 5001,
 # disjoint from the training seed 101 and the evaluation seed 9001), by the rule written in
 # models/README.md before the first training; never on default-eval or shrec19.

@@ -281,11 +281,14 @@ Model Model::load(const std::string& path) {
     Model low_noise(config);
     read_network(reader, reader.member(*gate, "low_noise", "noise_gate"), "noise_gate.low_noise",
                  low_noise);
-    const float threshold = reader.finite_float(reader.member(*gate, "threshold", "noise_gate"),
+    model.noise_threshold = reader.finite_float(reader.member(*gate, "threshold", "noise_gate"),
                                                 "noise_gate.threshold");
-    if (!(threshold > 0.0f)) reader.fail("noise_gate.threshold", "must be > 0");
     model.low_noise = std::make_shared<const Model>(std::move(low_noise));
-    model.noise_threshold = threshold;
+    try {
+      model.check();
+    } catch (const Error& e) {
+      reader.fail(e.element(), e.reason());
+    }
   }
   return model;
 }

@@ -17,7 +17,7 @@
 // A model file may hold a noise gate: a second network of the same config, trained on clean
 // clouds, that answers a whole cloud instead of the first when more than half of the cloud's
 // points have a noise statistic (edges::noise_statistic) below the gate's threshold
-// (docs/edges.md, "The noise gate").
+// (docs/edges.md, "gate").
 #include <cstddef>
 #include <cstdint>
 #include <memory>
