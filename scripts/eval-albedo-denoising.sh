@@ -22,7 +22,7 @@ for scene in $SCENES; do
     "$GLINT" --quiet lights "$OUT/capture-$scene" -o "$OUT/lights-$scene.json"
   [[ -f "$OUT/$scene/materials.json" ]] ||
     "$GLINT" --quiet reconstruct "$OUT/seq-$scene" --lights "$OUT/lights-$scene.json" --gt-poses \
-      --shadows off -o "$OUT/$scene" --report "$OUT/$scene-reconstruct.json"
+      --shadows off --indirect off -o "$OUT/$scene" --report "$OUT/$scene-reconstruct.json"
   [[ -f "$OUT/$scene-export.json" ]] ||
     "$GLINT" export "$OUT/$scene" -o "$OUT/$scene-denoised.glb" --denoise-albedo \
       --albedo-truth "$OUT/seq-$scene" --report "$OUT/$scene-export.json"

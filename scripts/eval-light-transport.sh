@@ -9,11 +9,13 @@
 # each rendering with glint's own segmentation, ground-truth poses and 2 cm observation voxels,
 # scored every 10th frame against the ground truth:
 #   before    --shadows off --indirect off (the paper's image model),
-#   after     --shadows on (the defaults),
-#   indirect  --shadows on --indirect on,
-#   before-unseen  --unseen-light on,
-#   unseen    --shadows on --unseen-light on,
-#   indirect-unseen  --shadows on --indirect on --unseen-light on,
+#   after     --shadows on --indirect off (shadow rays alone),
+#   indirect  --shadows on --indirect on --indirect-scale off (the gather as it is),
+#   scaled    --shadows on --indirect on --indirect-scale on (the defaults: the gather scaled by
+#             what the voxels no light reaches show),
+#   before-unseen  --indirect off --unseen-light on,
+#   unseen    --shadows on --indirect off --unseen-light on,
+#   indirect-unseen  --shadows on --indirect on --indirect-scale off --unseen-light on,
 # plus, for the timing tables, the "indirect" settings on each rendering b at 1 cm and 2 cm with
 # ground-truth segmentation (TIMING_SCENES). Reports: OUT/<scene>-<render>-<variant>.json;
 # summary: OUT/summary.md (scripts/light-transport-summary.py).
@@ -64,13 +66,16 @@ for scene in $SCENES; do
   for r in a b c; do
     render "$scene" "$r" || continue
     reconstruct "$scene" "$r" before --shadows off --indirect off --eval-every 10
-    reconstruct "$scene" "$r" after --shadows on --eval-every 10
-    reconstruct "$scene" "$r" indirect --shadows on --indirect on --eval-every 10
+    reconstruct "$scene" "$r" after --shadows on --indirect off --eval-every 10
+    reconstruct "$scene" "$r" indirect --shadows on --indirect on --indirect-scale off \
+      --eval-every 10
+    reconstruct "$scene" "$r" scaled --shadows on --indirect on --indirect-scale on \
+      --eval-every 10
     reconstruct "$scene" "$r" before-unseen --shadows off --indirect off --unseen-light on \
       --eval-every 10
-    reconstruct "$scene" "$r" unseen --shadows on --unseen-light on --eval-every 10
-    reconstruct "$scene" "$r" indirect-unseen --shadows on --indirect on --unseen-light on \
-      --eval-every 10
+    reconstruct "$scene" "$r" unseen --shadows on --indirect off --unseen-light on --eval-every 10
+    reconstruct "$scene" "$r" indirect-unseen --shadows on --indirect on --indirect-scale off \
+      --unseen-light on --eval-every 10
   done
 done
 for scene in $TIMING_SCENES; do

@@ -30,7 +30,7 @@ GLINT=${1:?usage: eval-reflectance.sh GLINT DATA [OUT] [SCENES] [FRAMES]}
 DATA=${2:?usage: eval-reflectance.sh GLINT DATA [OUT] [SCENES] [FRAMES]}
 VARIANT=${VARIANT:-noshadow}
 case $VARIANT in
-  noshadow) LIGHT_TRANSPORT=(--no-shadows) PIPELINE=(--shadows off)
+  noshadow) LIGHT_TRANSPORT=(--no-shadows) PIPELINE=(--shadows off --indirect off)
     DEFAULT_OUT=build/eval-reflectance ;;
   shadow) LIGHT_TRANSPORT=() PIPELINE=() DEFAULT_OUT=build/eval-reflectance-shadow ;;
   bounce[1-9] | bounce[1-9][0-9])

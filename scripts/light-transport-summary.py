@@ -2,8 +2,9 @@
 """Summary of scripts/eval-light-transport.sh as Markdown: per scene and rendering (a: direct
 light without shadows, b: with shadows, c: with shadows and indirect light), before (the paper's
 image model), before-unseen (that and the segments' unseen light), after (shadows), indirect
-(shadows and indirect light), unseen (shadows and the unseen light) and indirect-unseen (all
-three), the averaged object L1 of
+(shadows and the gathered indirect light), scaled (that scaled by what unlit voxels show: the
+defaults), unseen (shadows and the unseen light) and indirect-unseen (shadows, the gather and the
+unseen light), the averaged object L1 of
 kd, refined kd, ks, alpha and the PSNR over the objects' pixels of kd, refined kd, RGB, refined
 RGB; each b and c row's gap to a; and the per-stage milliseconds per frame of the timing runs
 beside paper 1's GTX 1080 totals.
@@ -13,7 +14,7 @@ import json
 import os
 import sys
 
-VARIANTS = ["before", "before-unseen", "after", "indirect", "unseen", "indirect-unseen"]
+VARIANTS = ["before", "before-unseen", "after", "indirect", "scaled", "unseen", "indirect-unseen"]
 PAPER_TOTALS = {"2cm": {"cubes": 17.294, "bunnies": 25.023, "office": 29.763},
                 "1cm": {"cubes": 23.919, "bunnies": 44.467, "office": 54.794}}
 STAGES = ["geometry", "observations", "segmentation", "shadows", "indirect", "specular", "albedo",

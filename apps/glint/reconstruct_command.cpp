@@ -304,10 +304,12 @@ void run_reconstruct(ReconstructOptions options) {
          {"indirect_rays", options.params.light_transport.indirect_rays},
          {"indirect_rays_per_frame", options.params.light_transport.indirect_rays_per_frame},
          {"indirect_pooling", options.params.light_transport.indirect_pooling},
+         {"indirect_scaled", options.params.light_transport.indirect_scaled},
          {"ray_offset_m", options.params.light_transport.ray_offset_m},
          {"model", model_path},
          {"model_input", reflectance::hemi_input_name(network.input())},
          {"lights", lights.capture}}},
+       {"indirect_scale", pipeline.light_transport().indirect_scale()},
        {"timings_ms", timings.to_json()},
        {"geometry_timings_ms", pipeline.geometry_timings().to_json()},
        {"command_timings_ms", command},
@@ -552,6 +554,11 @@ void register_reconstruct_command(CLI::App& app) {
                     "neighbours on the same surface (within 26 degrees and half a voxel of its "
                     "tangent plane), so it has light after a few frames and less noise (off = "
                     "its own rays only)");
+  add_on_off_option(command, "--indirect-scale", transport.indirect_scaled,
+                    "With --indirect on: scale the gathered light by what the voxels no light "
+                    "reaches directly show (their brightness over the gather's prediction, the "
+                    "scene's median): none where they are black, more where the gather misses "
+                    "light bounced off surfaces the camera never saw (off = the gather as is)");
   command
       ->add_option("--ray-offset", transport.ray_offset_m,
                    "Shadow and gather rays start this far (metres) off the surface along its "

@@ -182,6 +182,8 @@ reflectance::ReflectanceParams params_from(const py::dict& options, std::string&
       p.light_transport.indirect_rays_per_frame = int(positive(value.cast<int>()));
     } else if (name == "indirect_pooling") {
       p.light_transport.indirect_pooling = value.cast<bool>();
+    } else if (name == "indirect_scale") {
+      p.light_transport.indirect_scaled = value.cast<bool>();
     } else if (name == "ray_offset") {
       p.light_transport.ray_offset_m = value.cast<float>();
     } else if (name == "seed") {

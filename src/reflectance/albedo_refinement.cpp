@@ -219,4 +219,12 @@ std::optional<RefinedAlbedo> solve_albedo(const DiffuseObservation& observed,
   return refined;
 }
 
+float indirect_scale_sample(const DiffuseObservation& observed, const Eigen::Vector3f& gathered,
+                            float reference) {
+  if (observed.cosines > observed.indirect || observed.lower_bound || !(reference > 0) ||
+      !(gathered.minCoeff() > 0))
+    return NAN;
+  return (float(M_PI) * observed.radiance.cwiseQuotient(gathered)).maxCoeff() / reference;
+}
+
 }  // namespace glint::reflectance

@@ -119,4 +119,12 @@ std::optional<DiffuseObservation> observe_diffuse(
 std::optional<RefinedAlbedo> solve_albedo(const DiffuseObservation& observed,
                                           const Eigen::Vector3f& unseen = Eigen::Vector3f::Zero());
 
+// One sample of the gather's scene scale (LightTransportParams::indirect_scaled) from a voxel no
+// light reaches directly (`observed.cosines` holds its indirect light alone): its diffuse radiance
+// is kd / pi * E_true, so pi * radiance / gathered is kd * E_true / E_gathered, and over the
+// segment's reference albedo (largest channels) the ratio E_true / E_gathered. NaN where it
+// gives none: direct light, a lower bound, no reference, a channel not gathered.
+float indirect_scale_sample(const DiffuseObservation& observed, const Eigen::Vector3f& gathered,
+                            float reference);
+
 }  // namespace glint::reflectance

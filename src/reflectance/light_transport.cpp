@@ -181,6 +181,12 @@ LightTransport::LightTransport(const LightTransportParams& params, std::size_t v
   if (!(params.indirect_max_distance_m > 0))
     throw Error("light transport", "indirect_max_distance_m", "must be > 0");
   positive(params.unseen_memory, "unseen_memory");
+  if (params.indirect_scale_min_samples < 1 ||
+      std::size_t(params.indirect_scale_min_samples) > kIndirectScaleSamples)
+    throw Error("light transport", "indirect_scale_min_samples", "must be in [1, 1024]");
+  if (!(params.indirect_scale_max > 0 && std::isfinite(params.indirect_scale_max)))
+    throw Error("light transport", "indirect_scale_max", "must be finite and > 0");
+  if (params.indirect_scaled) scale_ = 0;
   if (!(params.unseen_fit.min_leverage >= 1))
     throw Error("light transport", "unseen_fit.min_leverage", "must be >= 1");
   if (!(params.unseen_fit.min_share >= 0))
@@ -413,6 +419,23 @@ void LightTransport::fuse_unseen(int segment, const RadianceLine& line) {
   fused.line.intercept += weight * (line.intercept - fused.line.intercept);
   fused.line.typical_irradiance +=
       weight * (line.typical_irradiance - fused.line.typical_irradiance);
+}
+
+void LightTransport::add_indirect_scale_samples(std::span<const float> samples) {
+  if (!params_.indirect_scaled || true_indirect_) return;
+  for (const float sample : samples) {
+    if (scale_samples_.size() < kIndirectScaleSamples) {
+      scale_samples_.push_back(sample);
+    } else {
+      scale_samples_[scale_next_] = sample;
+      scale_next_ = (scale_next_ + 1) % kIndirectScaleSamples;
+    }
+  }
+  if (scale_samples_.size() < std::size_t(params_.indirect_scale_min_samples)) return;
+  scale_scratch_ = scale_samples_;
+  const auto middle = scale_scratch_.begin() + std::ptrdiff_t(scale_scratch_.size() / 2);
+  std::nth_element(scale_scratch_.begin(), middle, scale_scratch_.end());
+  scale_ = std::clamp(*middle, 0.0f, params_.indirect_scale_max);
 }
 
 PointLighting PointLightingQuery::operator()(const Eigen::Vector3f& p, const Eigen::Vector3f& n) {

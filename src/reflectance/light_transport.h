@@ -28,6 +28,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "core/pool_memory.h"
@@ -47,13 +48,14 @@ class Renderer;
 namespace glint::reflectance {
 
 struct LightTransportParams {
-  // Shadows on and the gather off by default, by the rule docs/decisions.md states: defaults
+  // Shadows and the scaled gather on by default, by the rules docs/decisions.md states: defaults
   // serve input whose light is physical (real captures, renderings with shadows), where shadow
-  // rays raise the refined albedo; the gather helps only where much light is bounced, at more
-  // than the rest of the pipeline's cost (figures: docs/benchmarks.md). Paper 1's image model,
-  // for renderings without shadows, is shadows = false.
+  // rays raise the refined albedo, and the gather, scaled by what the voxels no light reaches
+  // show (indirect_scaled), raises it where light bounces and takes nothing out where none does,
+  // at about the rest of the pipeline's cost again (figures: docs/benchmarks.md). Paper 1's
+  // image model, for renderings without shadows, is shadows = false, indirect = false.
   bool shadows = true;
-  bool indirect = false;
+  bool indirect = true;
   // With shadows: the albedo test of the shadows the fused geometry misses (occluders whose far
   // side the camera never saw, docs/decisions.md "Shadows the fused geometry misses"). A voxel
   // whose refined albedo differs from its segment's reference by more than shadow_test_ratio
@@ -83,6 +85,19 @@ struct LightTransportParams {
   // surface (pools_indirect_rays()): on its own rays alone a voxel seen every frame needs 16
   // frames to reach indirect_min_rays (docs/decisions.md, "The gather pools its neighbours' rays").
   bool indirect_pooling = true;
+  // Multiply every voxel's gathered irradiance by one scene scale measured where no light
+  // reaches directly: there a voxel's diffuse radiance is kd / pi * E_true, so its albedo solved
+  // under the gathered E alone, over its segment's reference, is E_true / E (ReflectancePipeline
+  // takes one such sample per due voxel). Black there (a rendering without bounced light) takes
+  // the gather out; the gather's shortfall (rays into what the camera never saw) is made up on
+  // average. The scale is the median of the latest kIndirectScaleSamples samples, 0 until
+  // indirect_scale_min_samples have come, clamped to [0, indirect_scale_max]. The cap: the
+  // gather finds about half the bounced light of renderings with bounces (docs/benchmarks.md),
+  // and the unlit voxels, where it misses most, overstate the rest of the scene's shortfall
+  // (cubes with 3 bounces: 2.8 uncapped).
+  bool indirect_scaled = true;
+  int indirect_scale_min_samples = 64;
+  float indirect_scale_max = 2;
   float indirect_max_distance_m = 10;
   // A hit voxel whose median observation reaches this radiance in a channel has clipped: a lamp
   // (its proxy in a synthetic sequence) or its glare, whose light is already direct; it counts
@@ -127,9 +142,11 @@ class LightTransport {
   // Renderer::indirect_irradiance() at its surface point, ray_offset_m off it, with
   // kTrueIndirectPaths paths, once, when it is first due. The oracle of `glint reconstruct
   // --gt-indirect`: it measures how much of the refined albedo's error under bounced light is
-  // the gather's (surfaces the camera never saw, their radiance taken as diffuse).
+  // the gather's (surfaces the camera never saw, their radiance taken as diffuse). The true
+  // light is not scaled (indirect_scale() 1).
   void use_true_indirect(std::shared_ptr<const render::Renderer> renderer) {
     true_indirect_ = std::move(renderer);
+    scale_ = 1;
   }
   // The estimate's relative standard error is the incoming radiance's coefficient of variation
   // over sqrt(512): 4.4 % of it (2,048 paths give office's (c) figures within 0.1 dB).
@@ -145,9 +162,19 @@ class LightTransport {
   PointLighting lighting(int v) const {
     PointLighting result;
     if (params_.shadows && shadow_cast_[v]) result.lit = lit_[v] & ~occluded_[v];
-    if (params_.indirect && indirect_estimated_[v]) result.indirect = indirect_[v];
+    if (params_.indirect && indirect_estimated_[v]) result.indirect = indirect_[v] * scale_;
     return result;
   }
+  // Voxel v's gathered indirect irradiance before the scene scale (zero where not estimated).
+  Eigen::Vector3f gathered(int v) const {
+    return params_.indirect && indirect_estimated_[v] ? indirect_[v] : Eigen::Vector3f::Zero();
+  }
+  // The scene scale of the gathered light (LightTransportParams::indirect_scaled; else 1).
+  float indirect_scale() const { return scale_; }
+  // Adds samples of E_true / E_gathered from voxels no light reaches directly and updates the
+  // scale (LightTransportParams::indirect_scaled; not with the true indirect light).
+  void add_indirect_scale_samples(std::span<const float> samples);
+  static constexpr std::size_t kIndirectScaleSamples = 1024;
   // The lights voxel v's shadow rays reach (all before they are cast, or without shadows),
   // before the albedo test.
   LightMask cast_lights(int v) const {
@@ -194,6 +221,10 @@ class LightTransport {
     int frames = 0;
   };
   std::vector<FusedLine> unseen_;
+  float scale_ = 1;                   // indirect_scale()
+  std::vector<float> scale_samples_;  // a ring of the latest kIndirectScaleSamples
+  std::size_t scale_next_ = 0;
+  std::vector<float> scale_scratch_;
 };
 
 // Whether voxel u's gather rays count in the indirect estimate of voxel v (surface points p,

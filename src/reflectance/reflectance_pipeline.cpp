@@ -163,6 +163,8 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
   fit_radiance_.resize(fit_segment_.size());
   const bool shadow_test =
       occupancy && transport_.params().shadows && transport_.params().shadow_test;
+  const bool scale_gather = transport_.params().indirect && transport_.params().indirect_scaled;
+  scale_samples_.assign(scale_gather ? albedo_due_.size() : 0, NAN);
   parallel_for_chunks(albedo_due_.size(), 64, [&](std::size_t begin, std::size_t end) {
     std::vector<FixedSums>& segment_sums = sums.local();
     for (std::size_t i = begin; i < std::min(begin + kVoxelAhead, end); ++i)
@@ -195,6 +197,10 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
         fit_irradiance_[i] = observed->irradiance;
         fit_radiance_[i] = observed->radiance;
       }
+      const float reference =
+          known ? albedo_reference_[std::size_t(segment)] : material->ward.kd.maxCoeff();
+      if (scale_gather && observed)
+        scale_samples_[i] = indirect_scale_sample(*observed, transport_.gathered(v), reference);
       const auto refined =
           observed ? solve_albedo(*observed, transport_.unseen(segment)) : std::nullopt;
       // Each voxel is written by one iteration only: the due list holds it once.
@@ -211,8 +217,6 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
         due_albedo_[i] = kd.maxCoeff();
         due_segment_[i] = segment;
       }
-      const float reference =
-          known ? albedo_reference_[std::size_t(segment)] : material->ward.kd.maxCoeff();
       const AlbedoVerdict verdict =
           judge_albedo(kd.maxCoeff(), refined->lower_bound, reference, params_.albedo_max_ratio);
       grid_.light_shortfall(v) = verdict.light_shortfall;
@@ -226,6 +230,10 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
   });
   update_albedo_references(segments);
   if (fit_unseen) fit_unseen_light(segments);
+  if (scale_gather) {
+    std::erase_if(scale_samples_, [](float sample) { return std::isnan(sample); });
+    transport_.add_indirect_scale_samples(scale_samples_);
+  }
   // Each segment's mean over its voxels solved reliably in this frame, into its
   // SegmentMaterial::kd_refined.
   for (int segment = 1; segment < segments; ++segment) {

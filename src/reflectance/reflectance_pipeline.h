@@ -185,6 +185,9 @@ class ReflectancePipeline {
   // unseen-light fit); one of those segment lists grouped by segment.
   std::vector<int> albedo_due_, due_segment_;
   std::vector<float> due_albedo_, by_segment_;
+  // Per due voxel no light reaches directly: its albedo under the gathered light alone over its
+  // segment's reference (NaN: not a sample).
+  std::vector<float> scale_samples_;
   std::vector<int> fit_segment_;
   std::vector<Eigen::Vector3f> fit_irradiance_, fit_radiance_, grouped_irradiance_,
       grouped_radiance_;

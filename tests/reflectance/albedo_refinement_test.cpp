@@ -362,5 +362,41 @@ TEST(AlbedoRefinement, UnseenIrradianceCompletesTheLightOfAVoxelNoLightReaches) 
   EXPECT_FLOAT_EQ(refined->indirect_share, 0.0f);
 }
 
+TEST(AlbedoRefinement, AVoxelNoLightReachesSamplesTheGathersShortfall) {
+  // True indirect light E, of which the gather found half (scaled by whatever the transport's
+  // scale is now: the sample compares with the gather before the scale).
+  const Eigen::Vector3f kd(0.5f, 0.4f, 0.2f), truth(0.4f, 0.3f, 0.3f), gathered = truth / 2;
+  std::vector<render::PointLight> lights(1);
+  lights[0].position = {0, 2, 0};
+  lights[0].intensity = {3, 3, 3};
+  const auto observe = [&](const Eigen::Vector3f& radiance, const PointLighting& lighting) {
+    std::vector<Observation> obs;
+    for (int k = 0; k < 4; ++k)
+      obs.emplace_back(radiance, Eigen::Vector3f(0.3f * float(k), 1, 0.1f).normalized(), k);
+    return *observe_diffuse(obs.data(), int(obs.size()), Eigen::Vector3f::Zero(),
+                            Eigen::Vector3f::UnitY(), lights, Eigen::Vector3f::Zero(), 0.1f,
+                            AlbedoAverage::median, INFINITY, lighting);
+  };
+  const Eigen::Vector3f radiance = kd.cwiseProduct(truth) / float(M_PI);
+  const float reference = kd.maxCoeff();
+  for (const float scale : {0.0f, 1.5f}) {
+    const PointLighting shadowed{.lit = 0, .indirect = gathered * scale};
+    EXPECT_NEAR(indirect_scale_sample(observe(radiance, shadowed), gathered, reference), 2.0f,
+                2e-3f)
+        << scale;  // half-float colours
+  }
+  // Black where no light reaches: no bounced light, the gather takes nothing out.
+  EXPECT_FLOAT_EQ(
+      indirect_scale_sample(observe(Eigen::Vector3f::Zero(), {.lit = 0}), gathered, reference),
+      0.0f);
+  // The light reaches it: its radiance is not the indirect light's alone.
+  EXPECT_TRUE(std::isnan(indirect_scale_sample(observe(radiance, {}), gathered, reference)));
+  // No gathered light in a channel, or no reference: no sample.
+  EXPECT_TRUE(std::isnan(indirect_scale_sample(observe(radiance, {.lit = 0}),
+                                               Eigen::Vector3f(0.2f, 0.0f, 0.1f), reference)));
+  EXPECT_TRUE(
+      std::isnan(indirect_scale_sample(observe(radiance, {.lit = 0}), gathered, std::nanf(""))));
+}
+
 }  // namespace
 }  // namespace glint::reflectance

@@ -313,6 +313,7 @@ class WallBesideFloor {
 TEST(LightTransport, GatheredIndirectIrradianceOfAFloorBesideAWhiteWallMatchesAQuadrature) {
   const WallBesideFloor scene;
   LightTransportParams params{.shadows = false, .indirect = true, .indirect_rays = 4096};
+  params.indirect_scaled = false;  // the gather as it is
   params.indirect_rays_per_frame = params.indirect_rays;
   params.indirect_every_frames = 1;
   // Each voxel's own estimate, and the pooled one (the default), which averages it with its
@@ -354,6 +355,7 @@ TEST(LightTransport, APooledEstimateHasLightBeforeItsVoxelHasEnoughRaysOfItsOwn)
   // with the hit voxels' radiance as above.
   const WallBesideFloor scene;
   LightTransportParams params{.shadows = false, .indirect = true, .indirect_rays_per_frame = 4};
+  params.indirect_scaled = false;  // the gather as it is
   params.indirect_every_frames = 1;
   params.indirect_pooling = false;
   const LightTransport alone = scene.gather(params);
@@ -370,6 +372,42 @@ TEST(LightTransport, APooledEstimateHasLightBeforeItsVoxelHasEnoughRaysOfItsOwn)
     sum_ratio += gathered / scene.expected(scene.position(v));
   }
   EXPECT_NEAR(sum_ratio / double(voxels.size()), 1.0, 0.1);
+}
+
+TEST(LightTransport, TheSceneScaleMultipliesTheGatheredLightOnceItHasEnoughSamples) {
+  const WallBesideFloor scene;
+  LightTransportParams params{.shadows = false, .indirect = true, .indirect_rays_per_frame = 16};
+  params.indirect_every_frames = 1;
+  params.indirect_scaled = true;
+  LightTransport transport = scene.gather(params);
+  const int v = scene.floor_voxels().front();
+  const Eigen::Vector3f gathered = transport.gathered(v);
+  ASSERT_GT(gathered.x(), 0.0f);
+  // No samples yet: the gathered light is not taken (it may be what a rendering lacks).
+  EXPECT_FLOAT_EQ(transport.indirect_scale(), 0.0f);
+  EXPECT_TRUE(transport.lighting(v).indirect.isZero());
+  const std::vector<float> samples(std::size_t(params.indirect_scale_min_samples) - 1, 1.5f);
+  transport.add_indirect_scale_samples(samples);
+  EXPECT_FLOAT_EQ(transport.indirect_scale(), 0.0f);
+  // The median of the samples, from indirect_scale_min_samples on.
+  const std::vector<float> more{1.5f, 1.5f, 0.1f};
+  transport.add_indirect_scale_samples(more);
+  EXPECT_FLOAT_EQ(transport.indirect_scale(), 1.5f);
+  EXPECT_TRUE(transport.lighting(v).indirect.isApprox(1.5f * gathered));
+  // The latest kIndirectScaleSamples count: a scene whose unlit voxels turn black loses the
+  // gathered light; samples beyond the cap are clamped to it.
+  const std::vector<float> black(LightTransport::kIndirectScaleSamples, 0.0f);
+  transport.add_indirect_scale_samples(black);
+  EXPECT_TRUE(transport.lighting(v).indirect.isZero());
+  const std::vector<float> bright(LightTransport::kIndirectScaleSamples / 2 + 1, 9.0f);
+  transport.add_indirect_scale_samples(bright);
+  EXPECT_FLOAT_EQ(transport.indirect_scale(), params.indirect_scale_max);
+  // Unscaled: the gather as it is, whatever the samples.
+  params.indirect_scaled = false;
+  LightTransport unscaled = scene.gather(params);
+  unscaled.add_indirect_scale_samples(black);
+  EXPECT_FLOAT_EQ(unscaled.indirect_scale(), 1.0f);
+  EXPECT_TRUE(unscaled.lighting(v).indirect.isApprox(gathered));
 }
 
 TEST(LightTransport, RaysArePooledOnlyAlongTheSameSurface) {
@@ -394,6 +432,9 @@ TEST(LightTransport, RejectsBadParameters) {
   EXPECT_THROW(LightTransport({.shadow_refresh_frames = 0}, 16), Error);
   EXPECT_THROW(LightTransport({.shadow_test_ratio = 0.9f}, 16), Error);
   EXPECT_THROW(LightTransport({.shadow_test_skip_m = -1}, 16), Error);
+  EXPECT_THROW(LightTransport({.indirect_scale_min_samples = 0}, 16), Error);
+  EXPECT_THROW(LightTransport({.indirect_scale_min_samples = 2000}, 16), Error);
+  EXPECT_THROW(LightTransport({.indirect_scale_max = 0}, 16), Error);
 }
 
 }  // namespace

@@ -54,9 +54,13 @@ TEST_F(ReconstructCli, WritesTheModelMaterialsLightsPicturesAndReport) {
   // --device auto: the GPU where this build has CUDA and there is one.
   EXPECT_FLOAT_EQ(report["parameters"]["albedo_smoothing"].get<float>(), 0.2f);
   EXPECT_FALSE(report["parameters"]["albedo_keep_clipped"].get<bool>());
-  // Shadow rays by default; the gather and the unseen light only when asked for.
+  // Shadow rays and the scaled gather by default; the unseen light only when asked for.
   EXPECT_TRUE(report["parameters"]["shadows"].get<bool>());
-  EXPECT_FALSE(report["parameters"]["indirect"].get<bool>());
+  EXPECT_TRUE(report["parameters"]["indirect"].get<bool>());
+  EXPECT_TRUE(report["parameters"]["indirect_scaled"].get<bool>());
+  // The cubes rendered with direct light only: the voxels no light reaches are black, so the
+  // gathered light is scaled to (nearly) nothing.
+  EXPECT_LT(report["indirect_scale"].get<float>(), 0.1f);
   EXPECT_FALSE(report["parameters"]["unseen_light"].get<bool>());
   EXPECT_FALSE(report["parameters"]["shadow_test"].get<bool>());
   EXPECT_EQ(report["parameters"]["model_input"], "radiance");  // HemiCnn's default config
@@ -317,7 +321,8 @@ TEST_F(ReconstructCli, BadInputsFailClearly) {
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("--gt-indirect"), std::string::npos) << result.output;
   EXPECT_NE(result.output.find("scene.json"), std::string::npos) << result.output;
-  result = glint("reconstruct " + path("seq") + " --gt-lights --gt-indirect -o " + path("y"));
+  result = glint("reconstruct " + path("seq") + " --gt-lights --indirect off --gt-indirect -o " +
+                 path("y"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("--indirect on"), std::string::npos) << result.output;
   EXPECT_FALSE(fs::exists(path("y")));
