@@ -18,7 +18,10 @@
 //    there). Indirect irradiance varies slowly along a surface, so a voxel's estimate pools the
 //    rays of its neighbours on the same surface (indirect_pooling): a new voxel gets its light
 //    after a few frames rather than after indirect_min_rays of its own rays, and with several
-//    times the rays.
+//    times the rays;
+//  - one scale for the whole scene's gathered light (indirect_scaled), measured where no light
+//    reaches directly, which takes the gather out where nothing bounces and makes up what it
+//    misses elsewhere.
 // Where the fused geometry lacks an occluder (a part the camera never saw), the shadow test
 // (LightTransportParams::shadow_test) lets a voxel's albedo name the light its ray missed; the
 // true scene of a synthetic sequence can stand in for the TSDF as an oracle (use_true_scene()).
