@@ -326,10 +326,14 @@ class Reconstruction {
   py::dict timings() {
     std::lock_guard lock(mutex_);
     py::dict d;
-    for (const char* stage :
-         {"geometry", "observations", "segmentation", "specular", "albedo", "total"})
-      d[stage] = pipeline_->timings().median_ms(stage);
+    const nlohmann::json stages = pipeline_->timings().to_json();
+    for (const auto& [stage, figures] : stages.items())
+      d[py::str(stage)] = figures["median"].get<double>();
     return d;
+  }
+  float indirect_scale() {
+    std::lock_guard lock(mutex_);
+    return pipeline_->light_transport().indirect_scale();
   }
 
  private:
@@ -432,8 +436,12 @@ empty or a previous reconstruction. (The CLI's per-frame pictures and report are
       .def_property_readonly("frames", &Reconstruction::frames, "Frames processed so far.")
       .def_property_readonly("model", &Reconstruction::model_path, "The HemiCNN model file used.")
       .def("timings", &Reconstruction::timings,
-           "Median milliseconds per frame of each stage (geometry, observations, segmentation,\n"
-           "specular, albedo, total), as the CLI's report.");
+           "Median milliseconds per frame of each stage run so far (geometry, observations,\n"
+           "segmentation, shadows, indirect, specular, albedo, total), as the CLI's report.")
+      .def_property_readonly(
+          "indirect_scale", &Reconstruction::indirect_scale,
+          "The scale of the gathered indirect light (indirect_scale=True): what the voxels no\n"
+          "light reaches directly show, 0 where they are black; 1 when not scaled.");
 }
 
 }  // namespace glint::python

@@ -16,7 +16,8 @@ def sequence(tmp_path_factory, cli):
     cli("synth", "cubes", "--frames", "12", "--width", "256", "--no-shadows", "-o",
         folder / "seq")
     cli("reconstruct", folder / "seq", "--gt-lights", "--gt-poses", "--gt-segmentation",
-        "--eval-every", "0", "--obs-spacing", "0", "-o", folder / "cli")
+        "--eval-every", "0", "--obs-spacing", "0", "-o", folder / "cli", "--report",
+        folder / "cli-report.json")
     return folder
 
 
@@ -39,6 +40,12 @@ def test_materials_and_outputs_equal_cli(sequence, tmp_path):
     cli_materials = json.loads((sequence / "cli/materials.json").read_text())
     assert reconstruction.materials() == cli_materials
     assert cli_materials["segments"] and cli_materials["segments"][0]["estimates"] > 0
+    # The gathered light's scale and the stages timed, as the CLI's report; rendered with direct
+    # light only, the voxels no light reaches are black and the gathered light is scaled away.
+    report = json.loads((sequence / "cli-report.json").read_text())
+    assert reconstruction.indirect_scale == pytest.approx(report["indirect_scale"])
+    assert reconstruction.indirect_scale < 0.1
+    assert set(reconstruction.timings()) == set(report["timings_ms"]) >= {"shadows", "indirect"}
 
     reconstruction.export(tmp_path / "py")
     for name in ("mesh.ply", "materials.json"):
@@ -76,6 +83,7 @@ def test_light_transport_options_equal_cli(sequence, tmp_path, cli):
     cli_materials = json.loads((tmp_path / "cli/materials.json").read_text())
     assert reconstruction.materials() == cli_materials
     assert all("unseen_irradiance" in s for s in cli_materials["segments"])
+    assert reconstruction.indirect_scale == 1
 
 
 def test_bad_inputs(sequence):
