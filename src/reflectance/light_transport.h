@@ -172,7 +172,8 @@ class LightTransport {
   Eigen::Vector3f gathered(int v) const {
     return params_.indirect && indirect_estimated_[v] ? indirect_[v] : Eigen::Vector3f::Zero();
   }
-  // The scene scale of the gathered light (LightTransportParams::indirect_scaled; else 1).
+  // The scene scale of the gathered light (LightTransportParams::indirect_scaled; 1 without the
+  // gather or the scale).
   float indirect_scale() const { return scale_; }
   // Adds samples of E_true / E_gathered from voxels no light reaches directly and updates the
   // scale (LightTransportParams::indirect_scaled; not with the true indirect light).

@@ -408,6 +408,8 @@ TEST(LightTransport, TheSceneScaleMultipliesTheGatheredLightOnceItHasEnoughSampl
   unscaled.add_indirect_scale_samples(black);
   EXPECT_FLOAT_EQ(unscaled.indirect_scale(), 1.0f);
   EXPECT_TRUE(unscaled.lighting(v).indirect.isApprox(gathered));
+  // Without the gather there is nothing to scale.
+  EXPECT_FLOAT_EQ(LightTransport({.indirect = false}, 16).indirect_scale(), 1.0f);
 }
 
 TEST(LightTransport, RaysArePooledOnlyAlongTheSameSurface) {
