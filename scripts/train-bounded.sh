@@ -13,8 +13,9 @@
 # below was lower (docs/decisions.md, "BoundED trains on CAD-kernel parts, not procedural shapes").
 # Each model is trained with seeds 1, 2 and 3 (two trainings at a time), and so is a low-noise
 # network on the clean CAD clouds alone, for the noise gate; batches hold the classes in equal
-# numbers (--balance) and the non-edge decision offset is tuned on the 5 % validation split. Which seed ships, and whether the new models replace the old ones, is decided
-# by scripts/select-bounded.py on the validation split and on a CAD validation set (seed 5001,
+# numbers (--balance) and the non-edge decision offset is tuned on the 5 % validation split.
+# Which seed ships, and whether the new models replace the old ones, is decided by
+# scripts/select-bounded.py on the validation split and on a CAD validation set (seed 5001,
 # disjoint from the training seed 101 and the evaluation seed 9001), by the rule written in
 # models/README.md before the first training; never on default-eval or shrec19.
 # scripts/select-noise-gate.py then pairs the chosen network with a low-noise one

@@ -186,7 +186,7 @@ LightTransport::LightTransport(const LightTransportParams& params, std::size_t v
     throw Error("light transport", "indirect_scale_min_samples", "must be in [1, 1024]");
   if (!(params.indirect_scale_max > 0 && std::isfinite(params.indirect_scale_max)))
     throw Error("light transport", "indirect_scale_max", "must be finite and > 0");
-  if (params.indirect && params.indirect_scaled) scale_ = 0;
+  if (scales_gather()) scale_ = 0;
   if (!(params.unseen_fit.min_leverage >= 1))
     throw Error("light transport", "unseen_fit.min_leverage", "must be >= 1");
   if (!(params.unseen_fit.min_share >= 0))
@@ -422,7 +422,7 @@ void LightTransport::fuse_unseen(int segment, const RadianceLine& line) {
 }
 
 void LightTransport::add_indirect_scale_samples(std::span<const float> samples) {
-  if (!params_.indirect_scaled || true_indirect_) return;
+  if (!scales_gather()) return;
   for (const float sample : samples) {
     if (scale_samples_.size() < kIndirectScaleSamples) {
       scale_samples_.push_back(sample);

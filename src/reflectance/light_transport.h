@@ -175,8 +175,12 @@ class LightTransport {
   // The scene scale of the gathered light (LightTransportParams::indirect_scaled; 1 without the
   // gather or the scale).
   float indirect_scale() const { return scale_; }
+  // Whether the gathered light is scaled: the gather on, scaled, and not the true scene's.
+  bool scales_gather() const {
+    return params_.indirect && params_.indirect_scaled && !true_indirect_;
+  }
   // Adds samples of E_true / E_gathered from voxels no light reaches directly and updates the
-  // scale (LightTransportParams::indirect_scaled; not with the true indirect light).
+  // scale (where scales_gather()).
   void add_indirect_scale_samples(std::span<const float> samples);
   static constexpr std::size_t kIndirectScaleSamples = 1024;
   // The lights voxel v's shadow rays reach (all before they are cast, or without shadows),

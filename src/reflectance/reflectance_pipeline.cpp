@@ -163,7 +163,7 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
   fit_radiance_.resize(fit_segment_.size());
   const bool shadow_test =
       occupancy && transport_.params().shadows && transport_.params().shadow_test;
-  const bool scale_gather = transport_.params().indirect && transport_.params().indirect_scaled;
+  const bool scale_gather = transport_.scales_gather();
   scale_samples_.assign(scale_gather ? albedo_due_.size() : 0, NAN);
   parallel_for_chunks(albedo_due_.size(), 64, [&](std::size_t begin, std::size_t end) {
     std::vector<FixedSums>& segment_sums = sums.local();
