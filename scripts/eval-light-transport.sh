@@ -9,14 +9,16 @@
 # each rendering with glint's own segmentation, ground-truth poses and 2 cm observation voxels,
 # scored every 10th frame against the ground truth:
 #   before    --shadows off --indirect off (the paper's image model),
-#   after     --shadows on --indirect off (shadow rays alone),
-#   indirect  --shadows on --indirect on --indirect-scale off (the gather as it is),
-#   scaled    --shadows on --indirect on --indirect-scale on (the defaults: the gather scaled by
-#             what the voxels no light reaches show),
+#   after     --shadows on --shadow-test off --indirect off (shadow rays alone),
+#   indirect  the same with --indirect on --indirect-scale off (the gather as it is),
+#   scaled    the same with --indirect on --indirect-scale on (the gather scaled by what the
+#             voxels no light reaches show),
+#   tested    --shadows on --shadow-test on --indirect on --indirect-scale on (the defaults: the
+#             scaled gather and the shadow test),
 #   before-unseen  --indirect off --unseen-light on,
-#   unseen    --shadows on --indirect off --unseen-light on,
-#   indirect-unseen  --shadows on --indirect on --indirect-scale off --unseen-light on,
-# plus, for the timing tables, the "indirect" settings on each rendering b at 1 cm and 2 cm with
+#   unseen    --shadows on --shadow-test off --indirect off --unseen-light on,
+#   indirect-unseen  the same with --indirect on --indirect-scale off,
+# plus, for the timing tables, the defaults on each rendering b at 1 cm and 2 cm with
 # ground-truth segmentation (TIMING_SCENES). Reports: OUT/<scene>-<render>-<variant>.json;
 # summary: OUT/summary.md (scripts/light-transport-summary.py).
 #   scripts/eval-light-transport.sh GLINT DATA [OUT] [SCENES] [FRAMES] [TIMING_SCENES]
@@ -66,24 +68,26 @@ for scene in $SCENES; do
   for r in a b c; do
     render "$scene" "$r" || continue
     reconstruct "$scene" "$r" before --shadows off --indirect off --eval-every 10
-    reconstruct "$scene" "$r" after --shadows on --indirect off --eval-every 10
-    reconstruct "$scene" "$r" indirect --shadows on --indirect on --indirect-scale off \
-      --eval-every 10
-    reconstruct "$scene" "$r" scaled --shadows on --indirect on --indirect-scale on \
-      --eval-every 10
+    reconstruct "$scene" "$r" after --shadows on --shadow-test off --indirect off --eval-every 10
+    reconstruct "$scene" "$r" indirect --shadows on --shadow-test off --indirect on \
+      --indirect-scale off --eval-every 10
+    reconstruct "$scene" "$r" scaled --shadows on --shadow-test off --indirect on \
+      --indirect-scale on --eval-every 10
+    reconstruct "$scene" "$r" tested --shadows on --shadow-test on --indirect on \
+      --indirect-scale on --eval-every 10
     reconstruct "$scene" "$r" before-unseen --shadows off --indirect off --unseen-light on \
       --eval-every 10
-    reconstruct "$scene" "$r" unseen --shadows on --indirect off --unseen-light on --eval-every 10
-    reconstruct "$scene" "$r" indirect-unseen --shadows on --indirect on --indirect-scale off \
+    reconstruct "$scene" "$r" unseen --shadows on --shadow-test off --indirect off \
       --unseen-light on --eval-every 10
+    reconstruct "$scene" "$r" indirect-unseen --shadows on --shadow-test off --indirect on \
+      --indirect-scale off --unseen-light on --eval-every 10
   done
 done
 for scene in $TIMING_SCENES; do
   lights "$scene"
   render "$scene" b
-  reconstruct "$scene" b timing-2cm --gt-segmentation --shadows on --indirect on --eval-every 0
-  reconstruct "$scene" b timing-1cm --gt-segmentation --shadows on --indirect on \
-    --obs-voxel 0.01 --eval-every 0
+  reconstruct "$scene" b timing-2cm --gt-segmentation --eval-every 0
+  reconstruct "$scene" b timing-1cm --gt-segmentation --obs-voxel 0.01 --eval-every 0
 done
 python3 "$(dirname "$0")/light-transport-summary.py" "$OUT" > "$OUT/summary.md"
 echo "eval-light-transport: reports in $OUT, summary in $OUT/summary.md"

@@ -2,9 +2,9 @@
 """Summary of scripts/eval-light-transport.sh as Markdown: per scene and rendering (a: direct
 light without shadows, b: with shadows, c: with shadows and indirect light), before (the paper's
 image model), before-unseen (that and the segments' unseen light), after (shadows), indirect
-(shadows and the gathered indirect light), scaled (that scaled by what unlit voxels show: the
-defaults), unseen (shadows and the unseen light) and indirect-unseen (shadows, the gather and the
-unseen light), the averaged object L1 of
+(shadows and the gathered indirect light), scaled (that scaled by what unlit voxels show), tested
+(that and the shadow test: the defaults), unseen (shadows and the unseen light) and
+indirect-unseen (shadows, the gather and the unseen light), the averaged object L1 of
 kd, refined kd, ks, alpha and the PSNR over the objects' pixels of kd, refined kd, RGB, refined
 RGB; each b and c row's gap to a; and the per-stage milliseconds per frame of the timing runs
 beside paper 1's GTX 1080 totals.
@@ -14,7 +14,8 @@ import json
 import os
 import sys
 
-VARIANTS = ["before", "before-unseen", "after", "indirect", "scaled", "unseen", "indirect-unseen"]
+VARIANTS = ["before", "before-unseen", "after", "indirect", "scaled", "tested", "unseen",
+            "indirect-unseen"]
 PAPER_TOTALS = {"2cm": {"cubes": 17.294, "bunnies": 25.023, "office": 29.763},
                 "1cm": {"cubes": 23.919, "bunnies": 44.467, "office": 54.794}}
 STAGES = ["geometry", "observations", "segmentation", "shadows", "indirect", "specular", "albedo",

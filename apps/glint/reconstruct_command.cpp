@@ -299,6 +299,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"exposure", options.params.exposure},
          {"shadows", options.params.light_transport.shadows},
          {"shadow_test", options.params.light_transport.shadow_test},
+         {"shadow_test_sigmas", options.params.light_transport.shadow_test_sigmas},
          {"indirect", options.params.light_transport.indirect},
          {"unseen_light", options.params.light_transport.unseen},
          {"indirect_rays", options.params.light_transport.indirect_rays},
@@ -310,6 +311,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"model_input", reflectance::hemi_input_name(network.input())},
          {"lights", lights.capture}}},
        {"indirect_scale", pipeline.light_transport().indirect_scale()},
+       {"indirect_error", pipeline.light_transport().indirect_error()},
        {"timings_ms", timings.to_json()},
        {"geometry_timings_ms", pipeline.geometry_timings().to_json()},
        {"command_timings_ms", command},
@@ -525,9 +527,17 @@ void register_reconstruct_command(CLI::App& app) {
   add_on_off_option(command, "--shadow-test", transport.shadow_test,
                     "With --shadows on: shadows the fused geometry misses (occluders whose far "
                     "side the camera never saw). A voxel whose albedo differs from its segment's "
-                    "by more than 1.2x leaves out the light, among those whose shadow ray grazes "
-                    "fused geometry, that brings its albedo nearest its segment's (may flatten "
-                    "texture there)");
+                    "by more than 1.2x (wider under gathered light, --shadow-test-sigmas) leaves "
+                    "out the light, among those whose shadow ray grazes fused geometry, that "
+                    "brings its albedo nearest its segment's (off = shadow rays alone; it may "
+                    "flatten a texture's darkest texels near objects)");
+  command
+      ->add_option("--shadow-test-sigmas", transport.shadow_test_sigmas,
+                   "With --shadow-test on and the scaled gather: the test's 1.2x widens by this "
+                   "many times the albedo's uncertainty from the gathered light (its share of "
+                   "the irradiance times the gather's measured error); 0 = 1.2x everywhere")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   add_on_off_option(command, "--indirect", transport.indirect,
                     "Interreflections: each voxel's indirect irradiance, gathered over its "
                     "hemisphere from the radiance observed on the surfaces around it, adds to the "

@@ -169,6 +169,8 @@ reflectance::ReflectanceParams params_from(const py::dict& options, std::string&
       p.light_transport.shadows = value.cast<bool>();
     } else if (name == "shadow_test") {
       p.light_transport.shadow_test = value.cast<bool>();
+    } else if (name == "shadow_test_sigmas") {
+      p.light_transport.shadow_test_sigmas = value.cast<float>();
     } else if (name == "indirect") {
       p.light_transport.indirect = value.cast<bool>();
     } else if (name == "unseen_light") {
@@ -368,7 +370,10 @@ Keyword options (the CLI's names, '_' for '-', and its defaults):
     trunc_per_depth=0.01, depth_max=4, blocks=262144, far_every, far_voxel_pixels,
     track_model_halvings, device='auto', segment_noise=0.5, albedo_every=4,
     albedo_average='median', albedo_keep_clipped=False, albedo_min_cosine=0.2,
-    albedo_smoothing=0.2, specular='hemicnn' ('hemicnn+fit'), normals='gradient' ('plane'),
+    albedo_max_ratio=3, albedo_max_indirect=0.5, albedo_smoothing=0.2, shadows=True,
+    shadow_test=True, shadow_test_sigmas=2, indirect=True, indirect_scale=True,
+    unseen_light=False, indirect_rays=64, indirect_rays_per_frame=2, indirect_pooling=True,
+    ray_offset=0.01, specular='hemicnn' ('hemicnn+fit'), normals='gradient' ('plane'),
     seed=1, render_normal_radius=0.02.
 
 Calls on one object are serialised (a lock); the GIL is released while each runs, so other

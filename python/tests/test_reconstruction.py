@@ -72,13 +72,14 @@ def test_materials_and_outputs_equal_cli(sequence, tmp_path):
 
 def test_light_transport_options_equal_cli(sequence, tmp_path, cli):
     """Shadows, the shadow test, the unscaled gather and the unseen light as `--shadows on
-    --shadow-test on --indirect on --indirect-scale off --unseen-light on` give the CLI's
-    materials."""
+    --shadow-test on --shadow-test-sigmas 1 --indirect on --indirect-scale off --unseen-light on`
+    give the CLI's materials."""
     cli("reconstruct", sequence / "seq", "--gt-lights", "--gt-poses", "--gt-segmentation",
         "--eval-every", "0", "--obs-spacing", "0", "--no-glb", "--shadows", "on", "--shadow-test",
-        "on", "--indirect", "on", "--indirect-scale", "off", "--unseen-light", "on", "-o",
-        tmp_path / "cli")
-    _, reconstruction, _ = run_python(sequence, shadows=True, shadow_test=True, indirect=True,
+        "on", "--shadow-test-sigmas", "1", "--indirect", "on", "--indirect-scale", "off",
+        "--unseen-light", "on", "-o", tmp_path / "cli")
+    _, reconstruction, _ = run_python(sequence, shadows=True, shadow_test=True,
+                                      shadow_test_sigmas=1.0, indirect=True,
                                       indirect_scale=False, unseen_light=True)
     cli_materials = json.loads((tmp_path / "cli/materials.json").read_text())
     assert reconstruction.materials() == cli_materials
@@ -95,6 +96,8 @@ def test_bad_inputs(sequence):
         glint.Reconstruction(seq.intrinsics, lights, obs_voxel=-1)
     with pytest.raises(glint.Error, match="indirect_rays: must be in \\[1, 65535\\], got 0"):
         glint.Reconstruction(seq.intrinsics, lights, indirect_rays=0)
+    with pytest.raises(glint.Error, match="shadow_test_sigmas: must be finite and >= 0"):
+        glint.Reconstruction(seq.intrinsics, lights, shadow_test_sigmas=-1)
     with pytest.raises(glint.Error, match="specular: phong: must be hemicnn or hemicnn\\+fit"):
         glint.Reconstruction(seq.intrinsics, lights, specular="phong")
     with pytest.raises(glint.Error, match="lights: light 0: needs position and intensity"):

@@ -176,6 +176,8 @@ LightTransport::LightTransport(const LightTransportParams& params, std::size_t v
     throw Error("light transport", "ray_offset_m", "must be finite and >= 0");
   if (!(params.shadow_test_ratio >= 1 && params.shadow_test_gain >= 1))
     throw Error("light transport", "shadow_test_ratio, shadow_test_gain", "must be >= 1");
+  if (!(params.shadow_test_sigmas >= 0 && std::isfinite(params.shadow_test_sigmas)))
+    throw Error("light transport", "shadow_test_sigmas", "must be finite and >= 0");
   if (!(params.shadow_test_skip_m >= 0 && params.shadow_test_margin_m >= 0))
     throw Error("light transport", "shadow_test_skip_m, shadow_test_margin_m", "must be >= 0");
   if (!(params.indirect_max_distance_m > 0))
@@ -435,7 +437,13 @@ void LightTransport::add_indirect_scale_samples(std::span<const float> samples) 
   scale_scratch_ = scale_samples_;
   const auto middle = scale_scratch_.begin() + std::ptrdiff_t(scale_scratch_.size() / 2);
   std::nth_element(scale_scratch_.begin(), middle, scale_scratch_.end());
-  scale_ = std::clamp(*middle, 0.0f, params_.indirect_scale_max);
+  const float median = *middle;
+  scale_ = std::clamp(median, 0.0f, params_.indirect_scale_max);
+  // 1.4826 MAD: a normal distribution's standard deviation, robust to the samples of voxels
+  // whose reference does not hold (a texture, a shadow the fused geometry misses).
+  for (float& sample : scale_scratch_) sample = std::fabs(sample - median);
+  std::nth_element(scale_scratch_.begin(), middle, scale_scratch_.end());
+  indirect_error_ = median > 0 ? 1.4826f * *middle / median : 0.0f;
 }
 
 PointLighting PointLightingQuery::operator()(const Eigen::Vector3f& p, const Eigen::Vector3f& n) {

@@ -51,23 +51,30 @@ class Renderer;
 namespace glint::reflectance {
 
 struct LightTransportParams {
-  // Shadows and the scaled gather on by default, by the rules docs/decisions.md states: defaults
-  // serve input whose light is physical (real captures, renderings with shadows), where shadow
-  // rays raise the refined albedo, and the gather, scaled by what the voxels no light reaches
-  // show (indirect_scaled), raises it where light bounces and takes nothing out where none does,
-  // at about the rest of the pipeline's cost again (figures: docs/benchmarks.md). Paper 1's
-  // image model, for renderings without shadows, is shadows = false, indirect = false.
+  // Shadows, the shadow test and the scaled gather on by default, by the rules docs/decisions.md
+  // states: defaults serve input whose light is physical (real captures, renderings with
+  // shadows), where shadow rays raise the refined albedo, the shadow test finds most of the
+  // shadows the fused geometry misses, and the gather, scaled by what the voxels no light
+  // reaches show (indirect_scaled), raises it where light bounces and takes nothing out where
+  // none does, at about the rest of the pipeline's cost again (figures: docs/benchmarks.md).
+  // Paper 1's image model, for renderings without shadows, is shadows = false, indirect = false.
   bool shadows = true;
   bool indirect = true;
   // With shadows: the albedo test of the shadows the fused geometry misses (occluders whose far
   // side the camera never saw, docs/decisions.md "Shadows the fused geometry misses"). A voxel
   // whose refined albedo differs from its segment's reference by more than shadow_test_ratio
-  // drops the light, among those whose shadow ray grazes fused geometry (passes through an
-  // allocated TSDF block from shadow_test_skip_m past the voxel to shadow_test_margin_m short
-  // of the light), that brings its albedo nearest the reference, if that improves the ratio by
-  // shadow_test_gain.
-  bool shadow_test = false;
+  // (widened under gathered light, shadow_test_sigmas) drops the light, among those whose
+  // shadow ray grazes fused geometry (passes through an allocated TSDF block from
+  // shadow_test_skip_m past the voxel to shadow_test_margin_m short of the light), that brings
+  // its albedo nearest the reference, if that improves the ratio by shadow_test_gain.
+  bool shadow_test = true;
   float shadow_test_ratio = 1.2f;
+  // Under gathered light a voxel's albedo is uncertain by its gathered share s of the
+  // irradiance times the gather's relative error e (indirect_error()), and a voxel that much
+  // darker than its reference is no evidence of a shadow (walls and furniture beside bounced
+  // light, where the gather falls short): the ratio's log widens by shadow_test_sigmas * s * e.
+  // 2 standard deviations, not tuned; 0: the fixed ratio.
+  float shadow_test_sigmas = 2;
   float shadow_test_gain = 1.1f;
   float shadow_test_skip_m = 0.1f;
   float shadow_test_margin_m = 0.3f;
@@ -179,8 +186,13 @@ class LightTransport {
   bool scales_gather() const {
     return params_.indirect && params_.indirect_scaled && !true_indirect_;
   }
+  // The scaled gather's relative error at one voxel: the spread of the scale's samples over
+  // their median (1.4826 MAD / median); 0 before the scale has enough samples, where their
+  // median is 0, or where the gather is not scaled. It also counts what else scatters their
+  // albedos (normals, textures), so it errs high.
+  float indirect_error() const { return indirect_error_; }
   // Adds samples of E_true / E_gathered from voxels no light reaches directly and updates the
-  // scale (where scales_gather()).
+  // scale and indirect_error() (where scales_gather()).
   void add_indirect_scale_samples(std::span<const float> samples);
   static constexpr std::size_t kIndirectScaleSamples = 1024;
   // The lights voxel v's shadow rays reach (all before they are cast, or without shadows),
@@ -230,6 +242,7 @@ class LightTransport {
   };
   std::vector<FusedLine> unseen_;
   float scale_ = 1;                   // indirect_scale()
+  float indirect_error_ = 0;          // indirect_error()
   std::vector<float> scale_samples_;  // a ring of the latest kIndirectScaleSamples
   std::size_t scale_next_ = 0;
   std::vector<float> scale_scratch_;

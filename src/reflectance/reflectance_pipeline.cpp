@@ -101,7 +101,10 @@ LightMask ReflectancePipeline::test_shadows(int v, const SegmentMaterial& materi
                : INFINITY;
   };
   float best = misfit(observed);
-  if (!(best > std::log(params.shadow_test_ratio))) return 0;
+  const float share = observed.cosines > 0 ? observed.indirect / observed.cosines : 0.0f;
+  if (!(best > std::log(params.shadow_test_ratio) +
+                   params.shadow_test_sigmas * share * transport_.indirect_error()))
+    return 0;
   const LightMask candidates =
       grazing_lights(occupancy, geometry_.volume(), lights_, grid_.position(v), grid_.normal(v),
                      lighting.lit, params);

@@ -412,6 +412,24 @@ TEST(LightTransport, TheSceneScaleMultipliesTheGatheredLightOnceItHasEnoughSampl
   EXPECT_FLOAT_EQ(LightTransport({.indirect = false}, 16).indirect_scale(), 1.0f);
 }
 
+// The scaled gather's error at one voxel: the spread of the scale's samples about their median,
+// 1.4826 MAD / median (a normal distribution's standard deviation, relative).
+TEST(LightTransport, TheGathersErrorIsTheSpreadOfTheScaleSamples) {
+  LightTransport transport({.shadows = false, .indirect = true}, 16);
+  EXPECT_EQ(transport.indirect_error(), 0.0f);
+  std::vector<float> samples(22, 1.0f);  // median 2, absolute deviations 21 x 0 and 43 x 1
+  samples.insert(samples.end(), 21, 2.0f);
+  samples.insert(samples.end(), 21, 3.0f);
+  transport.add_indirect_scale_samples(samples);
+  EXPECT_FLOAT_EQ(transport.indirect_scale(), 2.0f);
+  EXPECT_FLOAT_EQ(transport.indirect_error(), 1.4826f / 2);
+  // Black unlit voxels (no bounced light): the scale is 0 and so is the error.
+  transport.add_indirect_scale_samples(
+      std::vector<float>(LightTransport::kIndirectScaleSamples, 0.0f));
+  EXPECT_EQ(transport.indirect_scale(), 0.0f);
+  EXPECT_EQ(transport.indirect_error(), 0.0f);
+}
+
 TEST(LightTransport, RaysArePooledOnlyAlongTheSameSurface) {
   const float voxel = 0.02f;
   const Eigen::Vector3f p(0, 0, 0), up = Eigen::Vector3f::UnitY();
@@ -433,6 +451,8 @@ TEST(LightTransport, RejectsBadParameters) {
   EXPECT_THROW(LightTransport({.ray_offset_m = -0.01f}, 16), Error);
   EXPECT_THROW(LightTransport({.shadow_refresh_frames = 0}, 16), Error);
   EXPECT_THROW(LightTransport({.shadow_test_ratio = 0.9f}, 16), Error);
+  EXPECT_THROW(LightTransport({.shadow_test_sigmas = -1}, 16), Error);
+  EXPECT_THROW(LightTransport({.shadow_test_sigmas = INFINITY}, 16), Error);
   EXPECT_THROW(LightTransport({.shadow_test_skip_m = -1}, 16), Error);
   EXPECT_THROW(LightTransport({.indirect_scale_min_samples = 0}, 16), Error);
   EXPECT_THROW(LightTransport({.indirect_scale_min_samples = 2000}, 16), Error);

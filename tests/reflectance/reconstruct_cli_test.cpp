@@ -54,7 +54,8 @@ TEST_F(ReconstructCli, WritesTheModelMaterialsLightsPicturesAndReport) {
   // --device auto: the GPU where this build has CUDA and there is one.
   EXPECT_FLOAT_EQ(report["parameters"]["albedo_smoothing"].get<float>(), 0.2f);
   EXPECT_FALSE(report["parameters"]["albedo_keep_clipped"].get<bool>());
-  // Shadow rays and the scaled gather by default; the unseen light only when asked for.
+  // Shadow rays, the shadow test and the scaled gather by default; the unseen light only when
+  // asked for.
   EXPECT_TRUE(report["parameters"]["shadows"].get<bool>());
   EXPECT_TRUE(report["parameters"]["indirect"].get<bool>());
   EXPECT_TRUE(report["parameters"]["indirect_scaled"].get<bool>());
@@ -62,7 +63,10 @@ TEST_F(ReconstructCli, WritesTheModelMaterialsLightsPicturesAndReport) {
   // gathered light is scaled to (nearly) nothing.
   EXPECT_LT(report["indirect_scale"].get<float>(), 0.1f);
   EXPECT_FALSE(report["parameters"]["unseen_light"].get<bool>());
-  EXPECT_FALSE(report["parameters"]["shadow_test"].get<bool>());
+  EXPECT_TRUE(report["parameters"]["shadow_test"].get<bool>());
+  EXPECT_FLOAT_EQ(report["parameters"]["shadow_test_sigmas"].get<float>(), 2.0f);
+  // Without bounced light the scale's samples are all 0: no spread to measure.
+  EXPECT_EQ(report["indirect_error"].get<float>(), 0.0f);
   EXPECT_EQ(report["parameters"]["model_input"], "radiance");  // HemiCnn's default config
   EXPECT_EQ(report["parameters"]["integration_device"],
             fusion::CudaIntegrator::available() ? "cuda" : "cpu");
