@@ -101,6 +101,8 @@ LightMask ReflectancePipeline::test_shadows(int v, const SegmentMaterial& materi
                : INFINITY;
   };
   float best = misfit(observed);
+  // The ratio widens by the albedo's uncertainty from the gathered light
+  // (LightTransportParams::shadow_test_sigmas).
   const float share = observed.cosines > 0 ? observed.indirect / observed.cosines : 0.0f;
   if (!(best > std::log(params.shadow_test_ratio) +
                    params.shadow_test_sigmas * share * transport_.indirect_error()))
