@@ -536,7 +536,7 @@ void register_reconstruct_command(CLI::App& app) {
                    "With --shadow-test on and the scaled gather: the test's 1.2x widens by this "
                    "many times the albedo's uncertainty from the gathered light (its share of "
                    "the irradiance times the gather's measured error); 0 = 1.2x everywhere")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   add_on_off_option(command, "--indirect", transport.indirect,
                     "Interreflections: each voxel's indirect irradiance, gathered over its "

@@ -247,6 +247,17 @@ TEST_F(ReconstructCli, BadInputsFailClearly) {
       glint("reconstruct " + path("seq") + " --gt-lights --albedo-max-indirect 2 -o " + path("x"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("--albedo-max-indirect"), std::string::npos) << result.output;
+  result =
+      glint("reconstruct " + path("seq") + " --gt-lights --shadow-test-sigmas -1 -o " + path("x"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("--shadow-test-sigmas: must be 0 or more, got -1"),
+            std::string::npos)
+      << result.output;
+  result =
+      glint("reconstruct " + path("seq") + " --gt-lights --shadow-test-sigmas inf -o " + path("x"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("shadow_test_sigmas: must be finite and >= 0"), std::string::npos)
+      << result.output;
   result = glint("reconstruct " + path("seq") + " --gt-lights --albedo-every 0 -o " + path("x"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("--albedo-every: must be more than 0, got 0"), std::string::npos)
