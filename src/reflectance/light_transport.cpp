@@ -188,7 +188,6 @@ LightTransport::LightTransport(const LightTransportParams& params, std::size_t v
     throw Error("light transport", "indirect_scale_min_samples", "must be in [1, 1024]");
   if (!(params.indirect_scale_max > 0 && std::isfinite(params.indirect_scale_max)))
     throw Error("light transport", "indirect_scale_max", "must be finite and > 0");
-  if (scales_gather()) scale_ = 0;
   if (!(params.unseen_fit.min_leverage >= 1))
     throw Error("light transport", "unseen_fit.min_leverage", "must be >= 1");
   if (!(params.unseen_fit.min_share >= 0))

@@ -156,7 +156,6 @@ class LightTransport {
   // light is not scaled (indirect_scale() 1).
   void use_true_indirect(std::shared_ptr<const render::Renderer> renderer) {
     true_indirect_ = std::move(renderer);
-    scale_ = 1;
   }
   // The estimate's relative standard error is the incoming radiance's coefficient of variation
   // over sqrt(512): 4.4 % of it (2,048 paths give office's (c) figures within 0.1 dB).
@@ -172,7 +171,8 @@ class LightTransport {
   PointLighting lighting(int v) const {
     PointLighting result;
     if (params_.shadows && shadow_cast_[v]) result.lit = lit_[v] & ~occluded_[v];
-    if (params_.indirect && indirect_estimated_[v]) result.indirect = indirect_[v] * scale_;
+    if (params_.indirect && indirect_estimated_[v])
+      result.indirect = indirect_[v] * indirect_scale();
     return result;
   }
   // Voxel v's gathered indirect irradiance before the scene scale (zero where not estimated).
@@ -181,7 +181,7 @@ class LightTransport {
   }
   // The scene scale of the gathered light (LightTransportParams::indirect_scaled; 1 without the
   // gather or the scale).
-  float indirect_scale() const { return scale_; }
+  float indirect_scale() const { return scales_gather() ? scale_ : 1.0f; }
   // Whether the gathered light is scaled: the gather on, scaled, and not the true scene's.
   bool scales_gather() const {
     return params_.indirect && params_.indirect_scaled && !true_indirect_;
@@ -241,7 +241,7 @@ class LightTransport {
     int frames = 0;
   };
   std::vector<FusedLine> unseen_;
-  float scale_ = 1;                   // indirect_scale()
+  float scale_ = 0;                   // indirect_scale() where scales_gather()
   float indirect_error_ = 0;          // indirect_error()
   std::vector<float> scale_samples_;  // a ring of the latest kIndirectScaleSamples
   std::size_t scale_next_ = 0;
