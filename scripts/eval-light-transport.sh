@@ -15,6 +15,7 @@
 #             voxels no light reaches show),
 #   tested    --shadows on --shadow-test on --indirect on --indirect-scale on (the defaults: the
 #             scaled gather and the shadow test),
+#   glossy    the defaults with --indirect-specular on (the gathered light mirrored by the lobe),
 #   before-unseen  --indirect off --unseen-light on,
 #   unseen    --shadows on --shadow-test off --indirect off --unseen-light on,
 #   indirect-unseen  the same with --indirect on --indirect-scale off,
@@ -75,6 +76,8 @@ for scene in $SCENES; do
       --indirect-scale on --eval-every 10
     reconstruct "$scene" "$r" tested --shadows on --shadow-test on --indirect on \
       --indirect-scale on --eval-every 10
+    reconstruct "$scene" "$r" glossy --shadows on --shadow-test on --indirect on \
+      --indirect-scale on --indirect-specular on --eval-every 10
     reconstruct "$scene" "$r" before-unseen --shadows off --indirect off --unseen-light on \
       --eval-every 10
     reconstruct "$scene" "$r" unseen --shadows on --shadow-test off --indirect off \

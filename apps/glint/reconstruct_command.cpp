@@ -306,6 +306,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"indirect_rays_per_frame", options.params.light_transport.indirect_rays_per_frame},
          {"indirect_pooling", options.params.light_transport.indirect_pooling},
          {"indirect_scaled", options.params.light_transport.indirect_scaled},
+         {"indirect_specular", options.params.light_transport.indirect_specular},
          {"ray_offset_m", options.params.light_transport.ray_offset_m},
          {"model", model_path},
          {"model_input", reflectance::hemi_input_name(network.input())},
@@ -569,6 +570,12 @@ void register_reconstruct_command(CLI::App& app) {
                     "reaches directly show (their brightness over the gather's prediction, the "
                     "scene's median): none where they are black, more where the gather misses "
                     "light bounced off surfaces the camera never saw (off = the gather as is)");
+  add_on_off_option(command, "--indirect-specular", transport.indirect_specular,
+                    "With --indirect on: the gathered light is also mirrored by the specular "
+                    "lobe (as an even sky: ks times its mean radiance times the lobe's albedo, "
+                    "about the view's cosine), which eq. (7) takes out of the observations and "
+                    "re-renderings add; for glossy objects under bounced light (off = diffuse "
+                    "only)");
   command
       ->add_option("--ray-offset", transport.ray_offset_m,
                    "Shadow and gather rays start this far (metres) off the surface along its "

@@ -42,6 +42,10 @@ inline constexpr LightMask kAllLights = ~LightMask{0};
 struct PointLighting {
   LightMask lit = kAllLights;
   Eigen::Vector3f indirect = Eigen::Vector3f::Zero();
+  // The indirect light seen as an even sky: the radiance the specular lobe reflects (ks times
+  // it; LightTransportParams::indirect_specular). Zero: the specular reflection of indirect
+  // light neglected.
+  Eigen::Vector3f indirect_radiance = Eigen::Vector3f::Zero();
   // The share of the reaching lights' direct light that the point's observations showed
   // (ObservationGrid::light_shortfall): below 1 in a shadow the fused geometry cannot cast. Only
   // re-renderings (ward_shading()) use it; the albedo refinement is what measures it.

@@ -458,7 +458,11 @@ PointLighting PointLightingQuery::operator()(const Eigen::Vector3f& p, const Eig
   if (indirect || (params.shadows && params.shadow_test))
     if (const int v = grid_.find(p, &blocks_); v >= 0) {
       result.lit &= ~transport_.occluded(v);
-      if (indirect) result.indirect = transport_.lighting(v, grid_.segment(v)).indirect;
+      if (indirect) {
+        const PointLighting voxel = transport_.lighting(v, grid_.segment(v));
+        result.indirect = voxel.indirect;
+        result.indirect_radiance = voxel.indirect_radiance;
+      }
     }
   return result;
 }

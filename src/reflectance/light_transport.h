@@ -109,6 +109,11 @@ struct LightTransportParams {
   int indirect_scale_min_samples = 64;
   float indirect_scale_max = 2;
   float indirect_max_distance_m = 10;
+  // The gathered light also reaches the Ward lobe, as an even sky of radiance E_ind / pi: a
+  // glossy surface mirrors the bounced light around it (the floor in a glossy bunny), which
+  // eq. (7) would otherwise take for albedo. The lobe reflects ks * E_ind / pi times its
+  // directional albedo (render::ward_lobe_albedo(), about cos(theta_o)).
+  bool indirect_specular = false;
   // A hit voxel whose median observation reaches this radiance in a channel has clipped: a lamp
   // (its proxy in a synthetic sequence) or its glare, whose light is already direct; it counts
   // as dark. The pipeline sets it from the exposure.
@@ -171,8 +176,10 @@ class LightTransport {
   PointLighting lighting(int v) const {
     PointLighting result;
     if (params_.shadows && shadow_cast_[v]) result.lit = lit_[v] & ~occluded_[v];
-    if (params_.indirect && indirect_estimated_[v])
+    if (params_.indirect && indirect_estimated_[v]) {
       result.indirect = indirect_[v] * indirect_scale();
+      if (params_.indirect_specular) result.indirect_radiance = result.indirect / float(M_PI);
+    }
     return result;
   }
   // Voxel v's gathered indirect irradiance before the scene scale (zero where not estimated).

@@ -16,9 +16,10 @@ namespace glint::reflectance {
 WardShading ward_shading(float alpha, const Eigen::Vector3f& p, const Eigen::Vector3f& n,
                          const Eigen::Vector3f& eye, const std::vector<render::PointLight>& lights,
                          const PointLighting& lighting) {
-  WardShading shading{lighting.indirect, Eigen::Vector3f::Zero()};
   const Eigen::Vector3f wo = (eye - p).normalized();
   if (!(n.dot(wo) > 0.0f)) return {Eigen::Vector3f::Zero(), Eigen::Vector3f::Zero()};
+  WardShading shading{lighting.indirect,
+                      lighting.indirect_radiance * render::ward_lobe_albedo(n.dot(wo), alpha)};
   for (std::size_t l = 0; l < lights.size(); ++l) {
     if (!lighting.reaches(l)) continue;
     const render::PointLight& light = lights[l];

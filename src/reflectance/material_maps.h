@@ -41,8 +41,9 @@ struct WardShading {
     return (material.kd / float(M_PI)).cwiseProduct(diffuse) + material.ks.cwiseProduct(specular);
   }
 };
-// With `lighting`, only the lights it lets reach p count, and its indirect irradiance adds to
-// diffuse (its specular reflection neglected, as in the albedo refinement's image model).
+// With `lighting`, only the lights it lets reach p count, its indirect irradiance adds to
+// diffuse and its indirect radiance (PointLighting::indirect_radiance) to specular, as in the
+// albedo refinement's image model.
 WardShading ward_shading(float alpha, const Eigen::Vector3f& p, const Eigen::Vector3f& n,
                          const Eigen::Vector3f& eye, const std::vector<render::PointLight>& lights,
                          const PointLighting& lighting = {});

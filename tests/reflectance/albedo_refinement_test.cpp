@@ -25,6 +25,19 @@ std::optional<RefinedAlbedo> refine_albedo(Args&&... args) {
   return diffuse ? solve_albedo(*diffuse) : std::nullopt;
 }
 
+// `count` views all round (`step` radians apart in azimuth) of a surface facing +y, rising from
+// `rise` over the horizontal by 0.1 per view, each seeing radiance(direction).
+template <class Radiance>
+std::vector<Observation> views_all_round(int count, float step, float rise, Radiance&& radiance) {
+  std::vector<Observation> obs;
+  for (int k = 0; k < count; ++k) {
+    const Eigen::Vector3f direction =
+        Eigen::Vector3f(std::cos(step * k), rise + 0.1f * k, std::sin(step * k)).normalized();
+    obs.emplace_back(radiance(direction), direction, k);
+  }
+  return obs;
+}
+
 TEST(AlbedoRefinement, RecoversTheDiffuseAlbedoOfARenderedVoxel) {
   render::WardMaterial m;
   m.kd = {0.6f, 0.3f, 0.1f};
@@ -295,14 +308,11 @@ TEST(AlbedoRefinement, ShadowedLightsAndIndirectLightAreTakenOutOfEquationSeven)
   const PointLighting lighting{.lit = kAllLights & ~LightMask{2},  // light 1 shadowed
                                .indirect = Eigen::Vector3f(0.4f, 0.3f, 0.2f)};
   const std::vector<render::PointLight> reaching{lights[0]};
-  std::vector<Observation> obs;
-  for (int k = 0; k < 10; ++k) {
-    const Eigen::Vector3f direction =
-        Eigen::Vector3f(std::cos(0.6f * k), 0.5f + 0.1f * k, std::sin(0.6f * k)).normalized();
-    const Eigen::Vector3f seen = observed(m, position, normal, direction, reaching) +
-                                 m.kd.cwiseProduct(lighting.indirect) / float(M_PI);
-    obs.emplace_back(seen, direction, k);
-  }
+  const std::vector<Observation> obs =
+      views_all_round(10, 0.6f, 0.5f, [&](const Eigen::Vector3f& direction) -> Eigen::Vector3f {
+        return observed(m, position, normal, direction, reaching) +
+               m.kd.cwiseProduct(lighting.indirect) / float(M_PI);
+      });
   const auto refined = refine_albedo(obs.data(), int(obs.size()), position, normal, lights, m.ks,
                                      m.alpha, AlbedoAverage::median, INFINITY, lighting);
   ASSERT_TRUE(refined.has_value());
@@ -335,6 +345,33 @@ TEST(AlbedoRefinement, ShadowedLightsAndIndirectLightAreTakenOutOfEquationSeven)
   EXPECT_FALSE(refine_albedo(unlit.data(), int(unlit.size()), position, normal, lights, m.ks,
                              m.alpha, AlbedoAverage::mean, INFINITY, PointLighting{.lit = 0})
                    .has_value());
+}
+
+// The specular reflection of indirect light as an even sky (LightTransportParams::
+// indirect_specular): the lobe reflects ks times its radiance times the lobe's directional
+// albedo (render::ward_lobe_albedo()), and eq. (7) takes that out before dividing by the
+// irradiance.
+TEST(AlbedoRefinement, IndirectLightTheLobeMirrorsIsTakenOutOfEquationSeven) {
+  const LitVoxel voxel({0.3f, 0.2f, 0.1f}, 0.4f, {0.5, 2.0, 0.3});
+  const render::WardMaterial& m = voxel.material;
+  const Eigen::Vector3f indirect(0.6f, 0.5f, 0.4f);
+  const PointLighting glossy{.indirect = indirect, .indirect_radiance = indirect / float(M_PI)};
+  const std::vector<Observation> obs =
+      views_all_round(8, 0.7f, 0.6f, [&](const Eigen::Vector3f& direction) -> Eigen::Vector3f {
+        const Eigen::Vector3f mirrored =
+            render::ward_lobe_albedo(voxel.normal.dot(direction), m.alpha) *
+            m.ks.cwiseProduct(indirect);
+        return voxel.seen_from(direction) + (m.kd.cwiseProduct(indirect) + mirrored) / float(M_PI);
+      });
+  const auto refine = [&](const PointLighting& lighting) {
+    return refine_albedo(obs.data(), int(obs.size()), voxel.position, voxel.normal, voxel.lights,
+                         m.ks, m.alpha, AlbedoAverage::median, INFINITY, lighting);
+  };
+  const auto refined = refine(glossy);
+  ASSERT_TRUE(refined.has_value());
+  EXPECT_TRUE(refined->kd.isApprox(m.kd, 2e-3f)) << refined->kd.transpose();
+  // Taken for albedo without it: the blue channel, where ks is largest against kd, by half.
+  EXPECT_GT(refine({.indirect = indirect})->kd.z(), 1.5f * m.kd.z());
 }
 
 TEST(AlbedoRefinement, UnseenIrradianceCompletesTheLightOfAVoxelNoLightReaches) {

@@ -408,6 +408,11 @@ TEST(LightTransport, TheSceneScaleMultipliesTheGatheredLightOnceItHasEnoughSampl
   unscaled.add_indirect_scale_samples(black);
   EXPECT_FLOAT_EQ(unscaled.indirect_scale(), 1.0f);
   EXPECT_TRUE(unscaled.lighting(v).indirect.isApprox(gathered));
+  EXPECT_TRUE(unscaled.lighting(v).indirect_radiance.isZero());  // the lobe mirrors none of it
+  // Mirrored by the specular lobe as well: as an even sky of radiance E / pi.
+  params.indirect_specular = true;
+  const LightTransport glossy = scene.gather(params);
+  EXPECT_TRUE(glossy.lighting(v).indirect_radiance.isApprox(gathered / float(M_PI)));
   // Without the gather there is nothing to scale.
   EXPECT_FLOAT_EQ(LightTransport({.indirect = false}, 16).indirect_scale(), 1.0f);
 }

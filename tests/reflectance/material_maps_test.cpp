@@ -367,6 +367,16 @@ TEST(MaterialMaps, AShadowTheGeometryCannotCastDimsTheDirectLightWhereItWasObser
   EXPECT_TRUE((dimmed.diffuse - lighting.indirect)
                   .isApprox(0.25f * (whole.diffuse - lighting.indirect), 1e-6f));
   EXPECT_TRUE(dimmed.specular.isApprox(0.25f * whole.specular, 1e-6f));
+  // Indirect light the lobe mirrors (an even sky of that radiance) adds ks times it.
+  render::WardMaterial m;
+  m.kd = {0.5f, 0.4f, 0.3f};
+  m.ks = {0.1f, 0.2f, 0.3f};
+  m.alpha = alpha;
+  lighting.indirect_radiance = lighting.indirect / float(M_PI);
+  const WardShading glossy = ward_shading(alpha, p, n, eye, lights, lighting);
+  const float lobe_albedo = render::ward_lobe_albedo(n.dot((eye - p).normalized()), alpha);
+  EXPECT_TRUE((glossy.radiance(m) - dimmed.radiance(m))
+                  .isApprox(lobe_albedo * m.ks.cwiseProduct(lighting.indirect_radiance), 1e-5f));
 }
 
 TEST(MaterialMaps, RenderingIntoUsedMapsGivesWhatFreshMapsGive) {

@@ -77,6 +77,26 @@ TEST(Ward, DirectionalAlbedoIsKdPlusAboutKs) {
   EXPECT_NEAR(albedo[1], 0.6, 0.02);
 }
 
+TEST(Ward, LobeAlbedoUnderAnEvenSkyFallsWithTheViewsCosine) {
+  // Midpoint rule in cos^2(theta_i) and azimuth: cos(theta_i) d(omega) = d(cos^2) d(phi) / 2.
+  constexpr int kRings = 2000, kSectors = 360;
+  for (const float alpha : {0.05f, 0.1f, 0.2f, 0.3f})
+    for (const float view : {0.0f, 0.5236f, 1.0472f}) {  // 0, 30 and 60 degrees
+      const Eigen::Vector3f wo = direction(view, 0.0f);
+      double integral = 0;
+      for (int i = 0; i < kRings; ++i) {
+        const float theta = std::acos(std::sqrt((float(i) + 0.5f) / kRings));
+        for (int j = 0; j < kSectors; ++j)
+          integral += ward_specular_lobe(
+              kUp, direction(theta, 2 * float(M_PI) * (float(j) + 0.5f) / kSectors), wo, alpha);
+      }
+      integral *= M_PI / (double(kRings) * kSectors);
+      EXPECT_NEAR(integral, ward_lobe_albedo(wo.z(), alpha), 0.03)
+          << "alpha " << alpha << ", view " << view;
+    }
+  EXPECT_EQ(ward_lobe_albedo(-0.5f, 0.1f), 0.0f);  // seen from below: no lobe
+}
+
 TEST(Ward, BatchedLobeMatchesTheScalarOne) {
   // Directions all over the sphere (below the surface and grazing ones included), several
   // roughnesses and a tilted normal; an odd count exercises the vector loop's remainder.
