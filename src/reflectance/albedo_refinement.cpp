@@ -170,10 +170,12 @@ std::optional<DiffuseObservation> observe_diffuse(const Observation* observation
   // Per observation sum_l exp(gamma_l) / N_l * L_l cos(theta_i,l); each light's incidence is
   // computed once per voxel.
   std::array<Eigen::Vector3f, kMaxObservationsPerVoxel> specular;
+  std::fill_n(specular.begin(), used, Eigen::Vector3f::Zero());
   // The indirect light the lobe mirrors (PointLighting::indirect_radiance), as an even sky.
-  for (int j = 0; j < used; ++j)
-    specular[j] = lighting.indirect_radiance *
-                  render::ward_lobe_albedo(normal.dot(Eigen::Vector3f(x[j], y[j], z[j])), alpha);
+  if (!lighting.indirect_radiance.isZero())
+    for (int j = 0; j < used; ++j)
+      specular[j] = lighting.indirect_radiance *
+                    render::ward_lobe_albedo(normal.dot(Eigen::Vector3f(x[j], y[j], z[j])), alpha);
   std::array<float, kMaxObservationsPerVoxel> lobe;
   // sum_l L_l cos(theta_i,l) + E_ind, and the same as luminance and with sin: indirect light
   // counts as if it came along the normal, where a normal error changes it least.
