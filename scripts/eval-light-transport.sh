@@ -13,9 +13,13 @@
 #   indirect  the same with --indirect on --indirect-scale off (the gather as it is),
 #   scaled    the same with --indirect on --indirect-scale on (the gather scaled by what the
 #             voxels no light reaches show),
-#   tested    --shadows on --shadow-test on --indirect on --indirect-scale on (the defaults: the
-#             scaled gather and the shadow test),
-#   glossy    the defaults with --indirect-specular on (the gathered light mirrored by the lobe),
+#   tested    --shadows on --shadow-test on --indirect on --indirect-scale on (the scaled gather
+#             and the shadow test),
+#   glossy    the same with --indirect-specular sky (the gathered light mirrored by the lobe as
+#             an even sky),
+#   mirror    the defaults: the same with --indirect-specular mirror (the lobe mirrors what its
+#             rays meet),
+# (the variants with the gather but not the lobe's reflection: --indirect-specular off),
 #   before-unseen  --indirect off --unseen-light on,
 #   unseen    --shadows on --shadow-test off --indirect off --unseen-light on,
 #   indirect-unseen  the same with --indirect on --indirect-scale off,
@@ -71,19 +75,21 @@ for scene in $SCENES; do
     reconstruct "$scene" "$r" before --shadows off --indirect off --eval-every 10
     reconstruct "$scene" "$r" after --shadows on --shadow-test off --indirect off --eval-every 10
     reconstruct "$scene" "$r" indirect --shadows on --shadow-test off --indirect on \
-      --indirect-scale off --eval-every 10
+      --indirect-scale off --indirect-specular off --eval-every 10
     reconstruct "$scene" "$r" scaled --shadows on --shadow-test off --indirect on \
-      --indirect-scale on --eval-every 10
+      --indirect-scale on --indirect-specular off --eval-every 10
     reconstruct "$scene" "$r" tested --shadows on --shadow-test on --indirect on \
-      --indirect-scale on --eval-every 10
+      --indirect-scale on --indirect-specular off --eval-every 10
     reconstruct "$scene" "$r" glossy --shadows on --shadow-test on --indirect on \
-      --indirect-scale on --indirect-specular on --eval-every 10
+      --indirect-scale on --indirect-specular sky --eval-every 10
+    reconstruct "$scene" "$r" mirror --shadows on --shadow-test on --indirect on \
+      --indirect-scale on --indirect-specular mirror --eval-every 10
     reconstruct "$scene" "$r" before-unseen --shadows off --indirect off --unseen-light on \
       --eval-every 10
     reconstruct "$scene" "$r" unseen --shadows on --shadow-test off --indirect off \
       --unseen-light on --eval-every 10
     reconstruct "$scene" "$r" indirect-unseen --shadows on --shadow-test off --indirect on \
-      --indirect-scale off --unseen-light on --eval-every 10
+      --indirect-scale off --indirect-specular off --unseen-light on --eval-every 10
   done
 done
 for scene in $TIMING_SCENES; do

@@ -239,12 +239,13 @@ void run_reconstruct(ReconstructOptions options) {
   log().info(
       "{} frames of {} ({}): {} segments, {} observation voxels; per frame: geometry "
       "{:.1f}, observations {:.1f}, segmentation {:.1f}, shadows {:.1f}, indirect {:.1f}, "
-      "specular {:.1f}, albedo {:.1f}, total {:.1f} ms (median) -> {}",
+      "specular {:.1f}, mirror {:.1f}, albedo {:.1f}, total {:.1f} ms (median) -> {}",
       frames, options.sequence, sequence.format, pipeline.segments().max_segment_id(),
       pipeline.observations().voxel_count(), timings.median_ms("geometry"),
       timings.median_ms("observations"), timings.median_ms("segmentation"),
       timings.median_ms("shadows"), timings.median_ms("indirect"), timings.median_ms("specular"),
-      timings.median_ms("albedo"), timings.median_ms("total"), options.output);
+      timings.median_ms("mirror"), timings.median_ms("albedo"), timings.median_ms("total"),
+      options.output);
   const reflectance::SpecularParams& specular = options.params.specular;
   const reflectance::MaterialCoverage coverage =
       reflectance::material_coverage(pipeline, specular.min_distinct_voxels);
@@ -306,7 +307,8 @@ void run_reconstruct(ReconstructOptions options) {
          {"indirect_rays_per_frame", options.params.light_transport.indirect_rays_per_frame},
          {"indirect_pooling", options.params.light_transport.indirect_pooling},
          {"indirect_scaled", options.params.light_transport.indirect_scaled},
-         {"indirect_specular", options.params.light_transport.indirect_specular},
+         {"indirect_specular",
+          reflectance::indirect_specular_name(options.params.light_transport.indirect_specular)},
          {"ray_offset_m", options.params.light_transport.ray_offset_m},
          {"model", model_path},
          {"model_input", reflectance::hemi_input_name(network.input())},
@@ -570,12 +572,21 @@ void register_reconstruct_command(CLI::App& app) {
                     "reaches directly show (their brightness over the gather's prediction, the "
                     "scene's median): none where they are black, more where the gather misses "
                     "light bounced off surfaces the camera never saw (off = the gather as is)");
-  add_on_off_option(command, "--indirect-specular", transport.indirect_specular,
-                    "With --indirect on: the gathered light is also mirrored by the specular "
-                    "lobe (as an even sky: ks times its mean radiance times the lobe's albedo, "
-                    "about the view's cosine), which eq. (7) takes out of the observations and "
-                    "re-renderings add; for glossy objects under bounced light (off = diffuse "
-                    "only)");
+  command
+      ->add_option_function<std::string>(
+          "--indirect-specular",
+          [options](const std::string& name) {
+            options->params.light_transport.indirect_specular =
+                reflectance::parse_indirect_specular(name);
+          },
+          "With --indirect on: what the specular lobe of a glossy surface mirrors of the bounced "
+          "light, which eq. (7) takes out of the observations and re-renderings add: mirror = "
+          "per observation, what one ray drawn from the lobe around its mirror direction meets "
+          "in the reconstruction (the floor below a glossy object, the dark above it; one ray "
+          "per stored observation, four per re-rendered pixel), sky = the gathered light as an "
+          "even sky, off = none")
+      ->check(CLI::IsMember({"off", "sky", "mirror"}))
+      ->default_str(reflectance::indirect_specular_name(transport.indirect_specular));
   command
       ->add_option("--ray-offset", transport.ray_offset_m,
                    "Shadow and gather rays start this far (metres) off the surface along its "

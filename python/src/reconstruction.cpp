@@ -187,7 +187,8 @@ reflectance::ReflectanceParams params_from(const py::dict& options, std::string&
     } else if (name == "indirect_scale") {
       p.light_transport.indirect_scaled = value.cast<bool>();
     } else if (name == "indirect_specular") {
-      p.light_transport.indirect_specular = value.cast<bool>();
+      p.light_transport.indirect_specular =
+          reflectance::parse_indirect_specular(value.cast<std::string>());
     } else if (name == "ray_offset") {
       p.light_transport.ray_offset_m = value.cast<float>();
     } else if (name == "seed") {
@@ -374,7 +375,7 @@ Keyword options (the CLI's names, '_' for '-', and its defaults):
     albedo_average='median', albedo_keep_clipped=False, albedo_min_cosine=0.2,
     albedo_max_ratio=3, albedo_max_indirect=0.5, albedo_smoothing=0.2, shadows=True,
     shadow_test=True, shadow_test_sigmas=2, indirect=True, indirect_scale=True,
-    indirect_specular=False, unseen_light=False, indirect_rays=64, indirect_rays_per_frame=2,
+    indirect_specular='mirror', unseen_light=False, indirect_rays=64, indirect_rays_per_frame=2,
     indirect_pooling=True, ray_offset=0.01, specular='hemicnn' ('hemicnn+fit'), normals='gradient' ('plane'),
     seed=1, render_normal_radius=0.02.
 

@@ -147,6 +147,7 @@ std::optional<DiffuseObservation> observe_diffuse(const Observation* observation
   // arrays, for the batched lobe.
   std::array<Eigen::Vector3f, kMaxObservationsPerVoxel> colour;
   std::array<float, kMaxObservationsPerVoxel> x, y, z;
+  std::array<int, kMaxObservationsPerVoxel> slot;
   int used = 0;
   // Clipped observations only where every one is: a clipped channel bounds the radiance from
   // below, so its eq. (7) albedo is too dark (by the clipped highlight's part, too).
@@ -161,6 +162,7 @@ std::optional<DiffuseObservation> observe_diffuse(const Observation* observation
       x[used] = direction.x();
       y[used] = direction.y();
       z[used] = direction.z();
+      slot[used] = k;
       colour[used++] = seen;
     }
     if (used > 0) break;
@@ -171,11 +173,18 @@ std::optional<DiffuseObservation> observe_diffuse(const Observation* observation
   // computed once per voxel.
   std::array<Eigen::Vector3f, kMaxObservationsPerVoxel> specular;
   std::fill_n(specular.begin(), used, Eigen::Vector3f::Zero());
-  // The indirect light the lobe mirrors (PointLighting::indirect_radiance), as an even sky.
-  if (!lighting.indirect_radiance.isZero())
-    for (int j = 0; j < used; ++j)
-      specular[j] = lighting.indirect_radiance *
-                    render::ward_lobe_albedo(normal.dot(Eigen::Vector3f(x[j], y[j], z[j])), alpha);
+  // The indirect light the lobe mirrors: each observation's mirror ray's, or an even sky
+  // (PointLighting::mirrored, indirect_radiance).
+  if (!lighting.indirect_radiance.isZero() || !lighting.mirrored.empty())
+    for (int j = 0; j < used; ++j) {
+      const std::size_t k = std::size_t(slot[j]);
+      const Eigen::Vector3f& mirrored =
+          k < lighting.mirrored.size() && lighting.mirrored[k].allFinite()
+              ? lighting.mirrored[k]
+              : lighting.indirect_radiance;
+      specular[j] =
+          mirrored * render::ward_lobe_albedo(normal.dot(Eigen::Vector3f(x[j], y[j], z[j])), alpha);
+    }
   std::array<float, kMaxObservationsPerVoxel> lobe;
   // sum_l L_l cos(theta_i,l) + E_ind, and the same as luminance and with sin: indirect light
   // counts as if it came along the normal, where a normal error changes it least.

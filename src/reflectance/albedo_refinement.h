@@ -10,9 +10,10 @@
 // the voxel's indirect irradiance E_ind gathered from the surfaces around it. With diffuse
 // interreflection the image model is
 //   B_k = kd / pi * (sum_l L_l cos(theta_i,l) + E_ind) + ks * sum_l exp(gamma_l) / N_l * ...
-// (the specular reflection of indirect light neglected, or, with
-// LightTransportParams::indirect_specular, that of an even sky of radiance E_ind / pi subtracted
-// with the specular terms: PointLighting::indirect_radiance), so kd is solved by dividing by the
+// plus the specular reflection of the indirect light, ks * L_k * rho(theta_o) with L_k the
+// radiance observation k's lobe mirrors (LightTransportParams::indirect_specular: what its lobe
+// ray met, PointLighting::mirrored, or an even sky, PointLighting::indirect_radiance; none when
+// off), subtracted with the lights' specular terms. So kd is solved by dividing by the
 // total irradiance rather than by subtracting kd_current / pi * E_ind from B_k: that needs no
 // albedo estimate (which the subtraction would feed back on itself: a kd that is too bright
 // takes too much out), and it still gives an albedo where every light is shadowed and only

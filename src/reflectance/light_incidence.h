@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
+#include <span>
 #include <vector>
 
 #include "render/scene.h"
@@ -42,10 +43,15 @@ inline constexpr LightMask kAllLights = ~LightMask{0};
 struct PointLighting {
   LightMask lit = kAllLights;
   Eigen::Vector3f indirect = Eigen::Vector3f::Zero();
-  // The indirect light seen as an even sky: the radiance the specular lobe reflects (ks times
-  // it; LightTransportParams::indirect_specular). Zero: the specular reflection of indirect
-  // light neglected.
+  // The indirect radiance the specular lobe reflects (ks times it times the lobe's albedo;
+  // LightTransportParams::indirect_specular): the gathered light as an even sky, or, for a
+  // re-rendered pixel, what its lobe rays met. Zero: the specular reflection of indirect light
+  // neglected.
   Eigen::Vector3f indirect_radiance = Eigen::Vector3f::Zero();
+  // Per stored observation of the voxel (by slot), the radiance its lobe ray met
+  // (IndirectSpecular::mirror), NaN where unknown (indirect_radiance stands in); empty: every
+  // observation mirrors indirect_radiance.
+  std::span<const Eigen::Vector3f> mirrored{};
   // The share of the reaching lights' direct light that the point's observations showed
   // (ObservationGrid::light_shortfall): below 1 in a shadow the fused geometry cannot cast. Only
   // re-renderings (ward_shading()) use it; the albedo refinement is what measures it.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -11,6 +12,7 @@
 #include "reflectance/hemi_image.h"
 #include "render/embree_scene.h"
 #include "render/renderer.h"
+#include "render/ward_sampling.h"
 
 namespace glint::reflectance {
 namespace {
@@ -107,6 +109,14 @@ void for_each_shadow_ray(const fusion::TsdfVolume& volume,
   }
 }
 
+// A hash of three integers: a voxel's grid coordinates (its random numbers then do not depend on
+// where in the pools it lies, which follows the threads' order of allocation) or a point's bits.
+std::uint64_t place_hash(const Eigen::Vector3i& place) {
+  return mix(std::uint64_t(std::uint32_t(place.x())) ^
+             std::uint64_t(std::uint32_t(place.y())) << 21 ^
+             std::uint64_t(std::uint32_t(place.z())) << 42);
+}
+
 // Queues voxel v's next `rays` gather rays: cosine-weighted directions from its sequence, whose
 // index `next` advances. The sequence is the additive recurrence of the plastic number (Roberts'
 // R2): low-discrepancy in [0, 1)^2 for any number of points, so a voxel's directions stratify
@@ -119,10 +129,7 @@ void queue_gather_rays(const ObservationGrid& grid, int v, int rays,
   const Eigen::Vector3f& normal = grid.normal(v);
   const Eigen::Matrix3f to_world = local_frame(normal).transpose();
   const Eigen::Vector3f origin = grid.position(v) + params.ray_offset_m * normal;
-  const Eigen::Vector3i place = grid.voxel_coordinates(v);
-  const std::uint64_t hash = mix(params.seed ^ mix(std::uint64_t(std::uint32_t(place.x())) ^
-                                                   std::uint64_t(std::uint32_t(place.y())) << 21 ^
-                                                   std::uint64_t(std::uint32_t(place.z())) << 42));
+  const std::uint64_t hash = mix(params.seed ^ place_hash(grid.voxel_coordinates(v)));
   const float shift_a = float(hash >> 40) * 0x1p-24f;
   const float shift_b = float((hash >> 16) & 0xFFFFFF) * 0x1p-24f;
   for (int k = 0; k < rays; ++k) {
@@ -156,9 +163,71 @@ bool gathered_radiance(const fusion::RayQueue& queue, int ray, const Observation
   return true;
 }
 
+// Queues `rays` rays from p (unit normal n) drawn from eq. (3)'s lobe for the view along unit
+// wo (towards the viewer): half vectors by Walter's sampling (render/ward_sampling.h), each
+// mirroring wo, stratified by the R2 sequence shifted by `hash`; those below the surface are not
+// queued. Returns how many were.
+int queue_lobe_rays(fusion::RayQueue& queue, int rays, const Eigen::Vector3f& p,
+                    const Eigen::Vector3f& n, const Eigen::Vector3f& wo, float alpha,
+                    std::uint64_t hash, const LightTransportParams& params, const WorldBox& box) {
+  constexpr float kR2a = 0.75487766624669276f, kR2b = 0.56984029099805327f;
+  const Eigen::Vector3f origin = p + params.ray_offset_m * n;
+  const float shift_a = float(hash >> 40) * 0x1p-24f;
+  const float shift_b = float((hash >> 16) & 0xFFFFFF) * 0x1p-24f;
+  int queued = 0;
+  for (int k = 0; k < rays; ++k) {
+    const Eigen::Vector3f h = render::sample_ward_half_vector(
+        n, alpha, fraction(shift_a + float(k) * kR2a), fraction(shift_b + float(k) * kR2b));
+    const Eigen::Vector3f wi = (2 * wo.dot(h) * h - wo).normalized();
+    if (!(n.dot(wi) > 0)) continue;
+    queue.add(origin, wi, std::min(params.indirect_max_distance_m, box.exit(origin, wi)));
+    ++queued;
+  }
+  return queued;
+}
+
+// Lobe rays per stored observation: eq. (7) takes a median over a voxel's observations, which
+// averages their one ray each. (Per re-rendered pixel: LightTransport::kPixelLobeRays.)
+constexpr int kObservationLobeRays = 1;
+
+// The mean radiance of `count` marched lobe rays from `first` (gathered_radiance()), NaN where
+// none is known.
+Eigen::Vector3f lobe_radiance(const fusion::RayQueue& queue, int first, int count,
+                              const ObservationGrid& grid,
+                              const std::vector<render::PointLight>& lights, float margin,
+                              float saturated_radiance, ObservationGrid::BlockCache& blocks) {
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero(), radiance;
+  int known = 0;
+  for (int ray = first; ray < first + count; ++ray)
+    if (gathered_radiance(queue, ray, grid, lights, margin, saturated_radiance, blocks, radiance)) {
+      sum += radiance;
+      ++known;
+    }
+  return known > 0 ? Eigen::Vector3f(sum / float(known)) : Eigen::Vector3f::Constant(NAN);
+}
+
 }  // namespace
 
-LightTransport::LightTransport(const LightTransportParams& params, std::size_t voxel_capacity)
+const char* indirect_specular_name(IndirectSpecular mode) {
+  switch (mode) {
+    case IndirectSpecular::sky:
+      return "sky";
+    case IndirectSpecular::mirror:
+      return "mirror";
+    default:
+      return "off";
+  }
+}
+
+IndirectSpecular parse_indirect_specular(const std::string& name) {
+  for (const IndirectSpecular mode :
+       {IndirectSpecular::off, IndirectSpecular::sky, IndirectSpecular::mirror})
+    if (name == indirect_specular_name(mode)) return mode;
+  throw Error("indirect specular", name, "must be off, sky or mirror");
+}
+
+LightTransport::LightTransport(const LightTransportParams& params, std::size_t voxel_capacity,
+                               int observations_per_voxel)
     : params_(params) {
   const auto positive = [](int value, const char* field) {
     if (value < 1) throw Error("light transport", field, "must be >= 1");
@@ -202,6 +271,9 @@ LightTransport::LightTransport(const LightTransportParams& params, std::size_t v
   indirect_next_ = make_pool<std::uint32_t>(voxel_capacity, "light transport indirect");
   indirect_ = make_pool<Eigen::Vector3f>(voxel_capacity, "light transport indirect");
   indirect_estimated_ = make_pool<bool>(voxel_capacity, "light transport indirect");
+  if (mirrors())
+    mirror_ = make_pool<MirrorSample>(voxel_capacity * std::size_t(observations_per_voxel),
+                                      "light transport mirror rays");
 }
 
 ShadowRays queue_shadow_rays(fusion::RayQueue& queue, const fusion::TsdfVolume& volume,
@@ -380,6 +452,94 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
   estimate_indirect(grid);
 }
 
+void LightTransport::update_mirrors(const ObservationGrid& grid, const fusion::TsdfVolume& volume,
+                                    const fusion::BlockOccupancy& occupancy,
+                                    const std::vector<render::PointLight>& lights,
+                                    std::span<const int> voxels,
+                                    const std::function<float(int)>& alpha) {
+  if (!mirrors()) return;
+  const WorldBox box(occupancy, volume);
+  const float margin = 2 * float(grid.params().voxel_size_m);
+  parallel_for_chunks(voxels.size(), kVoxelsPerQueue, [&](std::size_t begin, std::size_t end) {
+    fusion::RayQueue queue(volume, &occupancy);
+    ObservationGrid::BlockCache blocks;
+    struct Cast {
+      std::size_t slot;
+      int first, count;
+    };
+    std::vector<Cast> casts;
+    for (std::size_t batch = begin; batch < end; batch += kVoxelsPerQueue) {
+      queue.clear();
+      casts.clear();
+      for (std::size_t i = batch; i < std::min(end, batch + kVoxelsPerQueue); ++i) {
+        const int v = voxels[i];
+        const float lobe_alpha = alpha(v);
+        if (!(lobe_alpha > 0)) continue;
+        const Observation* observations = grid.observations(v);
+        const Eigen::Vector3f& normal = grid.normal(v);
+        for (int k = 0; k < grid.observation_count(v); ++k) {
+          const std::size_t slot = grid.first_slot(v) + std::size_t(k);
+          const std::uint32_t tag = observations[k].frame() + 1;
+          if (mirror_[slot].tag == tag) continue;
+          mirror_[slot] = {.tag = tag};
+          const Eigen::Vector3f view = observations[k].direction();
+          if (!(normal.dot(view) > 0)) continue;
+          const int first = queue.size();
+          const std::uint64_t hash =
+              mix(params_.seed ^ place_hash(grid.voxel_coordinates(v)) ^ std::uint64_t(tag) << 32);
+          const int count = queue_lobe_rays(queue, kObservationLobeRays, grid.position(v), normal,
+                                            view, lobe_alpha, hash, params_, box);
+          casts.push_back({slot, first, count});
+        }
+      }
+      queue.march();
+      for (const Cast& cast : casts) {
+        const Eigen::Vector3f radiance = lobe_radiance(queue, cast.first, cast.count, grid, lights,
+                                                       margin, params_.saturated_radiance, blocks);
+        if (!radiance.allFinite()) continue;
+        MirrorSample& sample = mirror_[cast.slot];
+        for (int c = 0; c < 3; ++c) sample.radiance[std::size_t(c)] = half_from_float(radiance[c]);
+        sample.known = true;
+      }
+    }
+  });
+}
+
+std::span<const Eigen::Vector3f> LightTransport::mirrored(
+    const ObservationGrid& grid, int v, std::span<Eigen::Vector3f> radiance) const {
+  if (!mirrors()) return {};
+  const float scale = mirror_scale();
+  const int count = grid.observation_count(v);
+  const Observation* observations = grid.observations(v);
+  for (int k = 0; k < count; ++k) {
+    const MirrorSample& sample = mirror_[grid.first_slot(v) + std::size_t(k)];
+    Eigen::Vector3f& out = radiance[std::size_t(k)];
+    if (!sample.known || sample.tag != observations[k].frame() + 1) {
+      out = Eigen::Vector3f::Constant(NAN);
+      continue;
+    }
+    for (int c = 0; c < 3; ++c) out[c] = scale * float_from_half(sample.radiance[std::size_t(c)]);
+  }
+  return radiance.first(std::size_t(count));
+}
+
+Eigen::Vector3f LightTransport::mirror_radiance(
+    fusion::RayQueue& queue, const ObservationGrid& grid, const fusion::BlockOccupancy& occupancy,
+    const fusion::TsdfVolume& volume, const std::vector<render::PointLight>& lights,
+    const Eigen::Vector3f& p, const Eigen::Vector3f& n, const Eigen::Vector3f& wo, float alpha,
+    ObservationGrid::BlockCache& blocks) const {
+  queue.clear();
+  Eigen::Vector3i bits;
+  std::memcpy(bits.data(), p.data(), sizeof(float) * 3);
+  const int count =
+      queue_lobe_rays(queue, kPixelLobeRays, p, n, wo, alpha, mix(params_.seed ^ place_hash(bits)),
+                      params_, WorldBox(occupancy, volume));
+  queue.march();
+  return lobe_radiance(queue, 0, count, grid, lights, 2 * float(grid.params().voxel_size_m),
+                       params_.saturated_radiance, blocks) *
+         mirror_scale();
+}
+
 void LightTransport::estimate_indirect(const ObservationGrid& grid) {
   const float voxel_size = float(grid.params().voxel_size_m);
   const int pool_size = params_.indirect_pooling ? 27 : 1;
@@ -445,7 +605,8 @@ void LightTransport::add_indirect_scale_samples(std::span<const float> samples) 
   indirect_error_ = median > 0 ? 1.4826f * *middle / median : 0.0f;
 }
 
-PointLighting PointLightingQuery::operator()(const Eigen::Vector3f& p, const Eigen::Vector3f& n) {
+PointLighting PointLightingQuery::operator()(const Eigen::Vector3f& p, const Eigen::Vector3f& n,
+                                             const Eigen::Vector3f& eye, float alpha) {
   PointLighting result;
   const LightTransportParams& params = transport_.params();
   if (params.shadows)
@@ -464,6 +625,14 @@ PointLighting PointLightingQuery::operator()(const Eigen::Vector3f& p, const Eig
         result.indirect_radiance = voxel.indirect_radiance;
       }
     }
+  if (transport_.mirrors() && alpha > 0) {
+    const Eigen::Vector3f view = (eye - p).normalized();
+    if (n.dot(view) > 0) {
+      const Eigen::Vector3f radiance = transport_.mirror_radiance(
+          rays_, grid_, occupancy_, volume_, lights_, p, n, view, alpha, blocks_);
+      if (radiance.allFinite()) result.indirect_radiance = radiance;
+    }
+  }
   return result;
 }
 

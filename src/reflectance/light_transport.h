@@ -21,17 +21,24 @@
 //    times the rays;
 //  - one scale for the whole scene's gathered light (indirect_scaled), measured where no light
 //    reaches directly, which takes the gather out where nothing bounces and makes up what it
-//    misses elsewhere.
+//    misses elsewhere;
+//  - per stored observation, what its specular lobe mirrors of the bounced light: the radiance
+//    one ray drawn from the lobe around its mirror direction meets (IndirectSpecular::mirror),
+//    cast once and kept beside the observation's slot.
 // Where the fused geometry lacks an occluder (a part the camera never saw), the shadow test
 // (LightTransportParams::shadow_test) lets a voxel's albedo name the light its ray missed; the
 // true scene of a synthetic sequence can stand in for the TSDF as an oracle (use_true_scene()).
 // Rays start ray_offset_m off the surface point along its normal: the point is the TSDF's zero
 // crossing, which a ray starting on it would find again (self-shadowing acne).
 #include <Eigen/Core>
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "core/pool_memory.h"
@@ -50,12 +57,27 @@ class Renderer;
 
 namespace glint::reflectance {
 
+// What the Ward lobe of a surface mirrors of the bounced light around it, ks times a radiance
+// times the lobe's directional albedo (render::ward_lobe_albedo(), about cos(theta_o)):
+//  - off: nothing (paper 1's image model);
+//  - sky: the gathered irradiance E_ind as an even sky of radiance E_ind / pi;
+//  - mirror: per stored observation, the mean radiance its lobe rays meet through the fused TSDF
+//    (rays drawn from eq. (3)'s lobe about the observation's mirror direction; the hit's diffuse
+//    radiance as the gather counts it, dark where a ray leaves the reconstruction, the even sky
+//    where none meets an observed surface), times the scene scale up to 1: the floor in a
+//    glossy object's lower half, the dark above it. One ray per stored observation, cast once
+//    (LightTransport::update_mirrors()), and kPixelLobeRays per re-rendered pixel.
+enum class IndirectSpecular { off, sky, mirror };
+const char* indirect_specular_name(IndirectSpecular mode);
+// Throws glint::Error for a name other than off, sky, mirror.
+IndirectSpecular parse_indirect_specular(const std::string& name);
+
 struct LightTransportParams {
-  // Shadows, the shadow test and the scaled gather on by default, by the rules docs/decisions.md
-  // states: defaults serve input whose light is physical (real captures, renderings with
-  // shadows), where shadow rays raise the refined albedo, the shadow test finds most of the
-  // shadows the fused geometry misses, and the gather, scaled by what the voxels no light
-  // reaches show (indirect_scaled), raises it where light bounces and takes nothing out where
+  // Shadows, the shadow test, the scaled gather and the lobe's mirror rays on by default, by the
+  // rules docs/decisions.md states: defaults serve input whose light is physical (real captures,
+  // renderings with shadows), where shadow rays raise the refined albedo, the shadow test finds
+  // most of the shadows the fused geometry misses, and the gather, scaled by what the voxels no
+  // light reaches show (indirect_scaled), raises it where light bounces and takes nothing out where
   // none does, at about the rest of the pipeline's cost again (figures: docs/benchmarks.md).
   // Paper 1's image model, for renderings without shadows, is shadows = false, indirect = false.
   bool shadows = true;
@@ -109,11 +131,11 @@ struct LightTransportParams {
   int indirect_scale_min_samples = 64;
   float indirect_scale_max = 2;
   float indirect_max_distance_m = 10;
-  // The gathered light also reaches the Ward lobe, as an even sky of radiance E_ind / pi: a
-  // glossy surface mirrors the bounced light around it (the floor in a glossy bunny), which
-  // eq. (7) would otherwise take for albedo. The lobe reflects ks * E_ind / pi times its
-  // directional albedo (render::ward_lobe_albedo(), about cos(theta_o)).
-  bool indirect_specular = false;
+  // What the Ward lobe mirrors of the bounced light (IndirectSpecular): a glossy surface
+  // mirrors the floor and its neighbours, which eq. (7) would otherwise take for albedo. The
+  // lobe rays by default, by the light-transport rule (docs/decisions.md, "The lobe mirrors
+  // what its rays meet"); with the scene scale 0 (no bounced light) they mirror nothing.
+  IndirectSpecular indirect_specular = IndirectSpecular::mirror;
   // A hit voxel whose median observation reaches this radiance in a channel has clipped: a lamp
   // (its proxy in a synthetic sequence) or its glare, whose light is already direct; it counts
   // as dark. The pipeline sets it from the exposure.
@@ -134,10 +156,18 @@ class LightTransport {
  public:
   // `voxel_capacity`: ObservationGrid::voxel_pool_size() of the grid it serves. Throws
   // glint::Error for bad parameters.
-  LightTransport(const LightTransportParams& params, std::size_t voxel_capacity);
+  // `observations_per_voxel`: ObservationGridParams::observations_per_voxel (the mirror rays'
+  // slots).
+  LightTransport(const LightTransportParams& params, std::size_t voxel_capacity,
+                 int observations_per_voxel = 0);
 
   const LightTransportParams& params() const { return params_; }
   bool enabled() const { return params_.shadows || params_.indirect || params_.unseen; }
+  // Whether the lobe mirrors each observation's lobe rays (IndirectSpecular::mirror, with the
+  // gather).
+  bool mirrors() const {
+    return params_.indirect && params_.indirect_specular == IndirectSpecular::mirror;
+  }
 
   // Casts the shadow rays due for the voxels `grid` saw in its latest collect(); more than
   // kMaxShadowedLights lights: the further ones are never shadowed. `occupancy` is of `volume`
@@ -170,6 +200,29 @@ class LightTransport {
                        const fusion::BlockOccupancy& occupancy,
                        const std::vector<render::PointLight>& lights, int frame);
 
+  // With IndirectSpecular::mirror: casts the lobe rays of the stored observations of `voxels` that
+  // have none yet (a slot's rays are cast again once a newer observation has taken the slot), drawn
+  // from eq. (3)'s lobe of width alpha(voxel) (voxels of alpha 0 are left out).
+  void update_mirrors(const ObservationGrid& grid, const fusion::TsdfVolume& volume,
+                      const fusion::BlockOccupancy& occupancy,
+                      const std::vector<render::PointLight>& lights, std::span<const int> voxels,
+                      const std::function<float(int)>& alpha);
+  // Voxel v's mirrored radiance per stored observation (PointLighting::mirrored) into `radiance`
+  // (at least its observation count): the span filled, empty but with IndirectSpecular::mirror.
+  std::span<const Eigen::Vector3f> mirrored(const ObservationGrid& grid, int v,
+                                            std::span<Eigen::Vector3f> radiance) const;
+  // The mean radiance kPixelLobeRays lobe rays from surface point p (unit normal n) for the view
+  // along unit wo meet, times mirror_scale(); NaN where none is known. `queue` is cleared first.
+  // A pixel shows its lobe's blur, where one sharp ray would alias.
+  static constexpr int kPixelLobeRays = 4;
+  Eigen::Vector3f mirror_radiance(fusion::RayQueue& queue, const ObservationGrid& grid,
+                                  const fusion::BlockOccupancy& occupancy,
+                                  const fusion::TsdfVolume& volume,
+                                  const std::vector<render::PointLight>& lights,
+                                  const Eigen::Vector3f& p, const Eigen::Vector3f& n,
+                                  const Eigen::Vector3f& wo, float alpha,
+                                  ObservationGrid::BlockCache& blocks) const;
+
   // Voxel v's lighting: the lights its shadow rays reach less those the shadow test found
   // occluded, and its indirect light; all lights and no indirect light for what is switched off,
   // not yet cast or not yet estimated.
@@ -178,10 +231,15 @@ class LightTransport {
     if (params_.shadows && shadow_cast_[v]) result.lit = lit_[v] & ~occluded_[v];
     if (params_.indirect && indirect_estimated_[v]) {
       result.indirect = indirect_[v] * indirect_scale();
-      if (params_.indirect_specular) result.indirect_radiance = result.indirect / float(M_PI);
+      if (params_.indirect_specular != IndirectSpecular::off)
+        result.indirect_radiance = result.indirect / float(M_PI);
     }
     return result;
   }
+  // The factor on the radiance the lobe rays meet: the scene scale up to 1. A rendering without
+  // bounced light (scale 0) mirrors nothing either; above 1 the scale makes up gather rays that
+  // met nothing known, which a lobe ray that met a known surface did not lose.
+  float mirror_scale() const { return std::min(indirect_scale(), 1.0f); }
   // Voxel v's gathered indirect irradiance before the scene scale (zero where not estimated).
   Eigen::Vector3f gathered(int v) const {
     return params_.indirect && indirect_estimated_[v] ? indirect_[v] : Eigen::Vector3f::Zero();
@@ -237,6 +295,15 @@ class LightTransport {
   PoolArray<std::uint32_t> indirect_next_;   // index of the next direction in the voxel's sequence
   PoolArray<Eigen::Vector3f> indirect_;      // the estimate lighting() gives, where ...
   PoolArray<bool> indirect_estimated_;       // ... it holds indirect_min_rays
+  // Per observation slot (ObservationGrid::first_slot()): the mean radiance its lobe rays met
+  // (binary16), whether any met a known one, and the frame + 1 of the observation they were
+  // cast for (0: none).
+  struct MirrorSample {
+    std::uint32_t tag = 0;
+    std::array<std::uint16_t, 3> radiance{};
+    bool known = false;
+  };
+  PoolArray<MirrorSample> mirror_;
   // indirect_ of the due voxels from the rays gathered so far (their own or their pool's).
   void estimate_indirect(const ObservationGrid& grid);
   std::vector<int> due_;  // scratch: the voxels due in a frame
@@ -304,14 +371,19 @@ class PointLightingQuery {
       : transport_(transport),
         grid_(grid),
         volume_(volume),
+        occupancy_(occupancy),
         lights_(lights),
         rays_(volume, &occupancy) {}
-  PointLighting operator()(const Eigen::Vector3f& p, const Eigen::Vector3f& n);
+  // With IndirectSpecular::mirror, `eye` (the viewpoint) and the lobe's width `alpha` give the lobe
+  // rays whose radiance it reflects (PointLighting::indirect_radiance).
+  PointLighting operator()(const Eigen::Vector3f& p, const Eigen::Vector3f& n,
+                           const Eigen::Vector3f& eye, float alpha);
 
  private:
   const LightTransport& transport_;
   const ObservationGrid& grid_;
   const fusion::TsdfVolume& volume_;
+  const fusion::BlockOccupancy& occupancy_;
   const std::vector<render::PointLight>& lights_;
   fusion::RayQueue rays_;
   ObservationGrid::BlockCache blocks_;

@@ -444,7 +444,8 @@ void render_material_maps(const fusion::SurfaceView& surface, const Pose& camera
         return (radiance * exposure).cwiseMax(0.0f).cwiseMin(1.0f).eval();
       };
       // The two materials differ in kd only: one shading serves both.
-      PointLighting light_here = lighting ? (*lighting)(p, n) : PointLighting{};
+      PointLighting light_here =
+          lighting ? (*lighting)(p, n, eye, material.fused.alpha) : PointLighting{};
       light_here.direct_share = material.direct_share;
       const WardShading shading = ward_shading(material.fused.alpha, p, n, eye, lights, light_here);
       put(maps.rgb, x, y, pixel(shading.radiance(material.fused)));

@@ -121,6 +121,14 @@ class ObservationGrid {
   const Eigen::Vector3f& normal(int v) const { return normal_[v]; }
   int observation_count(int v) const { return observation_count_[v]; }
   const Observation* observations(int v) const { return observations_.get() + first_slot(v); }
+  // The first of voxel v's observation slots (0 while it has none: nothing reads them then),
+  // below voxel_pool_size() * observations_per_voxel: per-slot data kept elsewhere is indexed
+  // by it.
+  std::size_t first_slot(int v) const {
+    return observation_set_[v] == 0
+               ? 0
+               : std::size_t(observation_set_[v] - 1) * params_.observations_per_voxel;
+  }
   // Asks for voxel v's own state (observation count and slots, surface point, normal, segment)
   // ahead of use: a frame's voxels lie scattered in the pools.
   void prefetch_voxel(int v) const;
@@ -183,12 +191,6 @@ class ObservationGrid {
     return (*cache)(block, [&](const Eigen::Vector3i& b) { return hash_.find(b); });
   }
 
-  // The first of voxel v's observation slots (0 while it has none: nothing reads them then).
-  std::size_t first_slot(int v) const {
-    return observation_set_[v] == 0
-               ? 0
-               : std::size_t(observation_set_[v] - 1) * params_.observations_per_voxel;
-  }
   // Coordinates within its block of the voxel with in-block index `local`.
   Eigen::Vector3i local_coordinates(int local) const {
     return {local % side_, (local / side_) % side_, local / (side_ * side_)};

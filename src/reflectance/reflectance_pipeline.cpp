@@ -70,7 +70,8 @@ ReflectancePipeline::ReflectancePipeline(const Intrinsics& intrinsics,
       segment_map_(params.segments),
       depth_segmenter_(halved_segmentation_params(params)),
       specular_(network, with_saturation(params.specular, params.exposure)),
-      transport_(with_saturation(params.light_transport, params.exposure), grid_.voxel_pool_size()),
+      transport_(with_saturation(params.light_transport, params.exposure), grid_.voxel_pool_size(),
+                 grid_.params().observations_per_voxel),
       lights_(std::move(lights)) {
   if (params.albedo_refresh_frames < 1)
     throw Error("reflectance pipeline", "albedo_refresh_frames", "must be >= 1");
@@ -129,13 +130,16 @@ LightMask ReflectancePipeline::test_shadows(int v, const SegmentMaterial& materi
   return dropped;
 }
 
-void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy* occupancy) {
+void ReflectancePipeline::collect_albedo_due() {
   // Due: voxels never refined, and those whose turn in the refresh cycle it is.
   albedo_due_.clear();
   for (const VisibleVoxel& seen : grid_.visible())
     if (!grid_.has_refined_kd(seen.voxel) ||
         (seen.voxel + frame_) % params_.albedo_refresh_frames == 0)
       albedo_due_.push_back(seen.voxel);
+}
+
+void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy* occupancy) {
   // The stage waits on memory more than it computes (1.3 us per voxel on office against 0.4 us
   // with its data in cache), so each chunk runs a two-stage prefetch: a voxel's own state
   // kVoxelAhead iterations early, then, once that has arrived, its observations.
@@ -172,6 +176,7 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
   scale_samples_.assign(scale_gather ? albedo_due_.size() : 0, NAN);
   parallel_for_chunks(albedo_due_.size(), 64, [&](std::size_t begin, std::size_t end) {
     std::vector<FixedSums>& segment_sums = sums.local();
+    std::array<Eigen::Vector3f, kMaxObservationsPerVoxel> mirrored;
     for (std::size_t i = begin; i < std::min(begin + kVoxelAhead, end); ++i)
       grid_.prefetch_voxel(albedo_due_[i]);
     for (std::size_t i = begin; i < end; ++i) {
@@ -186,6 +191,7 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
       const bool known = in_map && !std::isnan(albedo_reference_[std::size_t(segment)]);
       PointLighting lighting = transport_.lighting(v);
       if (shadow_test) lighting.lit = transport_.cast_lights(v);
+      lighting.mirrored = transport_.mirrored(grid_, v, mirrored);
       auto observed =
           observe_diffuse(grid_.observations(v), grid_.observation_count(v), grid_.position(v),
                           grid_.normal(v), lights_, material->ward.ks, material->ward.alpha,
@@ -349,6 +355,16 @@ ReflectanceFrame ReflectancePipeline::process(const io::RgbdFrame& frame,
   timings_.add("specular", stage.elapsed_ms());
 
   stage.restart();
+  collect_albedo_due();
+  if (occupancy) {
+    transport_.update_mirrors(
+        grid_, geometry_.volume(), *occupancy, lights_, albedo_due_, [&](int v) {
+          const SegmentMaterial* material = specular_.material(grid_.segment(v));
+          return material ? material->ward.alpha : 0.0f;
+        });
+    timings_.add("mirror", stage.elapsed_ms());
+    stage.restart();
+  }
   refine_albedo_of_visible(occupancy ? &*occupancy : nullptr);
   timings_.add("albedo", stage.elapsed_ms());
   timings_.add("total", total.elapsed_ms());

@@ -4,16 +4,17 @@
 //   observations  the coarse observation grid collects (radiance, direction) pairs (§3.4)
 //   segmentation  per-frame depth segmentation, propagated to global segment ids (§3.5), or
 //                 the sequence's ground-truth segment ids
-//   specular      HemiCNN per segment on 25 sampled voxels, fused over time (§3.6)
 //   shadows       which lights reach each seen voxel, by shadow rays through the TSDF (glint's
 //                 addition, reflectance/light_transport.h)
 //   indirect      each seen voxel's indirect irradiance, gathered from the observed radiance
 //                 of the surfaces around it (glint's addition, the same header)
 //   specular      HemiCNN per segment on 25 sampled voxels, fused over time (§3.6)
+//   mirror        the lobe rays of the due voxels' new observations: what their lobes mirror
+//                 of the bounced light (IndirectSpecular::mirror, the same header)
 //   albedo        per-voxel diffuse albedo from eq. (7) with the segment's ks, alpha (§3.7)
 // Stage times go into timings() as "geometry", "observations", "segmentation", "shadows",
-// "indirect", "specular", "albedo" and "total" (milliseconds per frame), the rows of paper 1
-// Tables 2-3 and glint's two.
+// "indirect", "specular", "mirror", "albedo" and "total" (milliseconds per frame), the rows of
+// paper 1 Tables 2-3 and glint's three.
 #include <memory>
 #include <vector>
 
@@ -146,6 +147,9 @@ class ReflectancePipeline {
   // into its SegmentMaterial::kd_refined: the albedo a re-rendering falls back on where no voxel
   // nearby has one (unlit or unobserved parts; the paper assumes a segment homogeneous).
   // `occupancy`: of the geometry as it is now, for the shadow test (null without shadows).
+  // The voxels whose albedo is due this frame (albedo_due_).
+  void collect_albedo_due();
+  // Eq. (7) for the due voxels.
   void refine_albedo_of_visible(const fusion::BlockOccupancy* occupancy);
   // The lights to leave out of voxel v's eq. (7), by the shadow test
   // (LightTransportParams::shadow_test): `observed` is under `lighting` (its cast lights) and

@@ -372,6 +372,27 @@ TEST(AlbedoRefinement, IndirectLightTheLobeMirrorsIsTakenOutOfEquationSeven) {
   EXPECT_TRUE(refined->kd.isApprox(m.kd, 2e-3f)) << refined->kd.transpose();
   // Taken for albedo without it: the blue channel, where ks is largest against kd, by half.
   EXPECT_GT(refine({.indirect = indirect})->kd.z(), 1.5f * m.kd.z());
+
+  // Each observation's lobe mirroring a radiance of its own (PointLighting::mirrored: what its
+  // lobe rays met), the even sky where that is unknown (NaN).
+  std::vector<Eigen::Vector3f> mirrored;
+  const std::vector<Observation> directional =
+      views_all_round(8, 0.7f, 0.6f, [&](const Eigen::Vector3f& direction) -> Eigen::Vector3f {
+        const int k = int(mirrored.size());
+        mirrored.push_back(k == 3 ? Eigen::Vector3f::Constant(NAN)
+                                  : Eigen::Vector3f(indirect * (0.2f * float(k % 4))));
+        const Eigen::Vector3f seen_in_lobe = k == 3 ? glossy.indirect_radiance : mirrored.back();
+        return voxel.seen_from(direction) + m.kd.cwiseProduct(indirect) / float(M_PI) +
+               render::ward_lobe_albedo(voxel.normal.dot(direction), m.alpha) *
+                   m.ks.cwiseProduct(seen_in_lobe);
+      });
+  PointLighting mirroring = glossy;
+  mirroring.mirrored = mirrored;
+  const auto refined_mirroring =
+      refine_albedo(directional.data(), int(directional.size()), voxel.position, voxel.normal,
+                    voxel.lights, m.ks, m.alpha, AlbedoAverage::median, INFINITY, mirroring);
+  ASSERT_TRUE(refined_mirroring.has_value());
+  EXPECT_TRUE(refined_mirroring->kd.isApprox(m.kd, 2e-3f)) << refined_mirroring->kd.transpose();
 }
 
 TEST(AlbedoRefinement, UnseenIrradianceCompletesTheLightOfAVoxelNoLightReaches) {

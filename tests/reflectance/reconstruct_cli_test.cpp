@@ -59,7 +59,7 @@ TEST_F(ReconstructCli, WritesTheModelMaterialsLightsPicturesAndReport) {
   EXPECT_TRUE(report["parameters"]["shadows"].get<bool>());
   EXPECT_TRUE(report["parameters"]["indirect"].get<bool>());
   EXPECT_TRUE(report["parameters"]["indirect_scaled"].get<bool>());
-  EXPECT_FALSE(report["parameters"]["indirect_specular"].get<bool>());
+  EXPECT_EQ(report["parameters"]["indirect_specular"].get<std::string>(), "mirror");
   // The cubes rendered with direct light only: the voxels no light reaches are black, so the
   // gathered light is scaled to (nearly) nothing.
   EXPECT_LT(report["indirect_scale"].get<float>(), 0.1f);
