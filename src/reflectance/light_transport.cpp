@@ -507,8 +507,9 @@ void LightTransport::update_mirrors(const ObservationGrid& grid, const fusion::T
 
 std::span<const Eigen::Vector3f> LightTransport::mirrored(
     const ObservationGrid& grid, int v, std::span<Eigen::Vector3f> radiance) const {
-  if (!mirrors()) return {};
   const float scale = mirror_scale();
+  // Scale 0 (no bounced light): every ray's radiance is 0, as the even sky's.
+  if (!mirrors() || scale == 0) return {};
   const int count = grid.observation_count(v);
   const Observation* observations = grid.observations(v);
   for (int k = 0; k < count; ++k) {

@@ -208,7 +208,8 @@ class LightTransport {
                       const std::vector<render::PointLight>& lights, std::span<const int> voxels,
                       const std::function<float(int)>& alpha);
   // Voxel v's mirrored radiance per stored observation (PointLighting::mirrored) into `radiance`
-  // (at least its observation count): the span filled, empty but with IndirectSpecular::mirror.
+  // (at least its observation count): the span filled; empty without IndirectSpecular::mirror
+  // or while mirror_scale() is 0 (PointLighting::indirect_radiance, then 0, stands in).
   std::span<const Eigen::Vector3f> mirrored(const ObservationGrid& grid, int v,
                                             std::span<Eigen::Vector3f> radiance) const;
   // The mean radiance kPixelLobeRays lobe rays from surface point p (unit normal n) for the view

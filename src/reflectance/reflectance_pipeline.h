@@ -143,13 +143,12 @@ class ReflectancePipeline {
   int frames_processed() const { return frame_; }
 
  private:
+  // The voxels whose albedo is due this frame (albedo_due_).
+  void collect_albedo_due();
   // Solves the due voxels' albedo (eq. 7), and fuses each segment's mean over its reliable ones
   // into its SegmentMaterial::kd_refined: the albedo a re-rendering falls back on where no voxel
   // nearby has one (unlit or unobserved parts; the paper assumes a segment homogeneous).
   // `occupancy`: of the geometry as it is now, for the shadow test (null without shadows).
-  // The voxels whose albedo is due this frame (albedo_due_).
-  void collect_albedo_due();
-  // Eq. (7) for the due voxels.
   void refine_albedo_of_visible(const fusion::BlockOccupancy* occupancy);
   // The lights to leave out of voxel v's eq. (7), by the shadow test
   // (LightTransportParams::shadow_test): `observed` is under `lighting` (its cast lights) and
