@@ -287,6 +287,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"albedo_min_light_cosine", options.params.albedo_min_light_cosine},
          {"albedo_max_ratio", options.params.albedo_max_ratio},
          {"albedo_max_indirect_share", options.params.albedo_max_indirect_share},
+         {"albedo_shrinkage", options.params.albedo_shrinkage},
          {"albedo_smoothing", options.params.albedo_smoothing},
          {"specular", specular_name(options.params.specular)},
          {"normals", normals_name(options.params.observations)},
@@ -481,6 +482,12 @@ void register_reconstruct_command(CLI::App& app) {
                    "reliable voxels around them or their segment's (1 = trust all)")
       ->check(CLI::Range(0.0f, 1.0f))
       ->capture_default_str();
+  add_on_off_option(command, "--albedo-shrinkage", params.albedo_shrinkage,
+                    "With --indirect on: pull each voxel's refined albedo towards its segment's "
+                    "by how much the gathered light's error (its share of the voxel's irradiance "
+                    "times the gather's measured error) exceeds the segment's own spread of "
+                    "albedo where little light is gathered; the colour stays, texture under "
+                    "direct light stays (off = eq. 7 as is)");
   command
       ->add_option("--albedo-smoothing", params.albedo_smoothing,
                    "Re-renderings and the mesh smooth the refined albedo between neighbouring "

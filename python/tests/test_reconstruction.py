@@ -73,15 +73,17 @@ def test_materials_and_outputs_equal_cli(sequence, tmp_path):
 def test_light_transport_options_equal_cli(sequence, tmp_path, cli):
     """Shadows, the shadow test, the unscaled gather mirrored by the lobe and the unseen light as
     `--shadows on --shadow-test on --shadow-test-sigmas 1 --indirect on --indirect-scale off
-    --indirect-specular mirror --unseen-light on` give the CLI's materials."""
+    --indirect-specular mirror --unseen-light on --albedo-shrinkage off` give the CLI's
+    materials."""
     cli("reconstruct", sequence / "seq", "--gt-lights", "--gt-poses", "--gt-segmentation",
         "--eval-every", "0", "--obs-spacing", "0", "--no-glb", "--shadows", "on", "--shadow-test",
         "on", "--shadow-test-sigmas", "1", "--indirect", "on", "--indirect-scale", "off",
-        "--indirect-specular", "mirror", "--unseen-light", "on", "-o", tmp_path / "cli")
+        "--indirect-specular", "mirror", "--unseen-light", "on", "--albedo-shrinkage", "off",
+        "-o", tmp_path / "cli")
     _, reconstruction, _ = run_python(sequence, shadows=True, shadow_test=True,
                                       shadow_test_sigmas=1.0, indirect=True,
                                       indirect_scale=False, indirect_specular="mirror",
-                                      unseen_light=True)
+                                      unseen_light=True, albedo_shrinkage=False)
     cli_materials = json.loads((tmp_path / "cli/materials.json").read_text())
     assert reconstruction.materials() == cli_materials
     assert all("unseen_irradiance" in s for s in cli_materials["segments"])

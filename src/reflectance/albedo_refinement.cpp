@@ -242,4 +242,12 @@ float indirect_scale_sample(const DiffuseObservation& observed, const Eigen::Vec
   return (float(M_PI) * observed.radiance.cwiseQuotient(gathered)).maxCoeff() / reference;
 }
 
+Eigen::Vector3f shrink_albedo(const Eigen::Vector3f& kd, float reference, float error,
+                              float spread) {
+  const float brightness = kd.maxCoeff();
+  if (!(error > 0) || !std::isfinite(spread) || !(reference > 0) || !(brightness > 0)) return kd;
+  const float weight = spread * spread / (spread * spread + error * error);
+  return (kd * std::pow(reference / brightness, 1 - weight)).cwiseMin(1.0f);
+}
+
 }  // namespace glint::reflectance

@@ -130,4 +130,14 @@ std::optional<RefinedAlbedo> solve_albedo(const DiffuseObservation& observed,
 float indirect_scale_sample(const DiffuseObservation& observed, const Eigen::Vector3f& gathered,
                             float reference);
 
+// Empirical Bayes shrinkage of a voxel's refined albedo towards its segment's where the gathered
+// light's error dominates it: kd * (reference / max kd)^(1 - w), w = spread^2 / (spread^2 +
+// error^2), in the log of the brightness (largest channel), whose error is relative. `error`:
+// the voxel's relative albedo error from the gathered light (its gathered share of the
+// irradiance times the gather's relative error); `spread`: its segment's own spread of log
+// brightness (texture and noise) where that error is small; `reference`: the segment's
+// brightness. The colour is kept. No error, no spread known (NaN) or no reference: kd as it is.
+Eigen::Vector3f shrink_albedo(const Eigen::Vector3f& kd, float reference, float error,
+                              float spread);
+
 }  // namespace glint::reflectance

@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "core/robust_statistics.h"
 #include "fusion/ray_queue.h"
 #include "fusion/tsdf_sampler.h"
 #include "reflectance/hemi_image.h"
@@ -595,15 +596,12 @@ void LightTransport::add_indirect_scale_samples(std::span<const float> samples) 
   }
   if (scale_samples_.size() < std::size_t(params_.indirect_scale_min_samples)) return;
   scale_scratch_ = scale_samples_;
-  const auto middle = scale_scratch_.begin() + std::ptrdiff_t(scale_scratch_.size() / 2);
-  std::nth_element(scale_scratch_.begin(), middle, scale_scratch_.end());
-  const float median = *middle;
+  const float median = median_in_place(scale_scratch_);
   scale_ = std::clamp(median, 0.0f, params_.indirect_scale_max);
-  // 1.4826 MAD: a normal distribution's standard deviation, robust to the samples of voxels
-  // whose reference does not hold (a texture, a shadow the fused geometry misses).
-  for (float& sample : scale_scratch_) sample = std::fabs(sample - median);
-  std::nth_element(scale_scratch_.begin(), middle, scale_scratch_.end());
-  indirect_error_ = median > 0 ? 1.4826f * *middle / median : 0.0f;
+  // Robust to the samples of voxels whose reference does not hold (a texture, a shadow the fused
+  // geometry misses).
+  const float spread = robust_spread_in_place(scale_scratch_, median);
+  indirect_error_ = median > 0 ? spread / median : 0.0f;
 }
 
 PointLighting PointLightingQuery::operator()(const Eigen::Vector3f& p, const Eigen::Vector3f& n,

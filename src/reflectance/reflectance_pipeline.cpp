@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "core/robust_statistics.h"
 #include "fusion/block_occupancy.h"
 #include "fusion/depth_maps.h"
 #include "reflectance/albedo_refinement.h"
@@ -173,6 +174,11 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
   const bool shadow_test =
       occupancy && transport_.params().shadows && transport_.params().shadow_test;
   const bool scale_gather = transport_.scales_gather();
+  const bool shrink = params_.albedo_shrinkage;
+  const float gather_error = shrink ? transport_.indirect_error() : 0.0f;
+  albedo_spread_.resize(std::size_t(segments), NAN);
+  spread_segment_.assign(shrink ? albedo_due_.size() : 0, -1);
+  spread_sample_.resize(spread_segment_.size());
   scale_samples_.assign(scale_gather ? albedo_due_.size() : 0, NAN);
   parallel_for_chunks(albedo_due_.size(), 64, [&](std::size_t begin, std::size_t end) {
     std::vector<FixedSums>& segment_sums = sums.local();
@@ -220,7 +226,15 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
       grid_.light_shortfall(v) = 0;
       if (!refined) continue;
       const Eigen::Vector3f kd = refined->kd.cwiseMax(0.0f).cwiseMin(1.0f);
-      grid_.refined_kd(v) = kd;
+      // The references, the segment sums and the verdict take the albedo before shrinkage.
+      const float albedo_error = refined->indirect_share * gather_error;
+      grid_.refined_kd(v) =
+          known ? shrink_albedo(kd, reference, albedo_error, albedo_spread_[std::size_t(segment)])
+                : kd;
+      if (shrink && known && albedo_error <= kSpreadMaxError && kd.maxCoeff() > 0) {
+        spread_segment_[i] = segment;
+        spread_sample_[i] = std::log(kd.maxCoeff() / reference);
+      }
       grid_.refined_kd_light_tangent(v) = refined->light_tangent;
       const bool trusted_light = refined->light_cosine() >= params_.albedo_min_light_cosine &&
                                  refined->indirect_share <= params_.albedo_max_indirect_share;
@@ -240,6 +254,7 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
     }
   });
   update_albedo_references(segments);
+  if (shrink) update_albedo_spreads(segments);
   if (fit_unseen) fit_unseen_light(segments);
   if (scale_gather) {
     std::erase_if(scale_samples_, [](float sample) { return std::isnan(sample); });
@@ -256,18 +271,34 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
   }
 }
 
-void ReflectancePipeline::update_albedo_references(int segments) {
-  group_by_segment(due_segment_, segments, segment_starts_, segment_fill_, segment_order_);
+void ReflectancePipeline::for_each_segment_sample(
+    const std::vector<int>& segment_of, const std::vector<float>& values, int segments,
+    const std::function<void(int, std::span<float>)>& visit) {
+  group_by_segment(segment_of, segments, segment_starts_, segment_fill_, segment_order_);
   by_segment_.resize(segment_order_.size());
   for (std::size_t k = 0; k < segment_order_.size(); ++k)
-    by_segment_[k] = due_albedo_[std::size_t(segment_order_[k])];
+    by_segment_[k] = values[std::size_t(segment_order_[k])];
   for (int segment = 1; segment < segments; ++segment) {
-    const auto first = by_segment_.begin() + segment_starts_[std::size_t(segment)];
-    const auto last = by_segment_.begin() + segment_starts_[std::size_t(segment) + 1];
-    if (last - first < kMinReferenceVoxels) continue;  // the last one stays
-    std::nth_element(first, first + (last - first) / 2, last);
-    albedo_reference_[std::size_t(segment)] = *(first + (last - first) / 2);
+    const int first = segment_starts_[std::size_t(segment)];
+    const int count = segment_starts_[std::size_t(segment) + 1] - first;
+    if (count >= kMinReferenceVoxels)
+      visit(segment, std::span<float>(by_segment_.data() + first, std::size_t(count)));
   }
+}
+
+void ReflectancePipeline::update_albedo_references(int segments) {
+  for_each_segment_sample(due_segment_, due_albedo_, segments,
+                          [&](int segment, std::span<float> albedos) {
+                            albedo_reference_[std::size_t(segment)] = median_in_place(albedos);
+                          });
+}
+
+void ReflectancePipeline::update_albedo_spreads(int segments) {
+  for_each_segment_sample(spread_segment_, spread_sample_, segments,
+                          [&](int segment, std::span<float> samples) {
+                            albedo_spread_[std::size_t(segment)] =
+                                robust_spread_in_place(samples, median_in_place(samples));
+                          });
 }
 
 void ReflectancePipeline::fit_unseen_light(int segments) {

@@ -15,7 +15,9 @@
 // Stage times go into timings() as "geometry", "observations", "segmentation", "shadows",
 // "indirect", "specular", "mirror", "albedo" and "total" (milliseconds per frame), the rows of
 // paper 1 Tables 2-3 and glint's three.
+#include <functional>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "core/timer.h"
@@ -83,6 +85,11 @@ struct ReflectanceParams {
   // the albedo's. Such voxels, mostly in shadow, take the albedo of their lit neighbours or
   // segment instead. 1 trusts them all.
   float albedo_max_indirect_share = 0.5f;
+  // Pull a voxel's refined albedo towards its segment's by how much the gathered light's error
+  // exceeds the segment's own spread of albedo (shrink_albedo()): the gather's error
+  // (LightTransport::indirect_error()) puts smooth blotches where it is much of the irradiance,
+  // while texture shows where it is not. No gathered light: no change. false: eq. (7) as is.
+  bool albedo_shrinkage = true;
   // Re-renderings and the mesh smooth the refined albedo between neighbouring voxels that agree
   // to about this relative contrast (interpolate_refined_kd in reflectance/material_maps.h);
   // 0 interpolates trilinearly only, as the paper. On a uniform surface a voxel's eq. (7) albedo
@@ -171,6 +178,11 @@ class ReflectancePipeline {
   LightTransport transport_;
   std::vector<render::PointLight> lights_;
   StageTimings timings_;
+  // Groups `values` (one per due voxel) by `segment_of` (-1: none) and calls visit(segment, its
+  // values, free to reorder) for each segment with at least kMinReferenceVoxels of them.
+  void for_each_segment_sample(const std::vector<int>& segment_of, const std::vector<float>& values,
+                               int segments,
+                               const std::function<void(int, std::span<float>)>& visit);
   // Updates each segment's reference albedo for the test of judge_albedo() in the next
   // frame, as its largest channel: the median over this frame's due voxels of their albedos
   // solved under trusted light, where the segment has at least kMinReferenceVoxels of them;
@@ -179,6 +191,12 @@ class ReflectancePipeline {
   // and the network's albedo can be off by more than the ratio (a dark object read as grey).
   void update_albedo_references(int segments);
   static constexpr int kMinReferenceVoxels = 16;
+  // Updates each segment's spread of log brightness (ReflectanceParams::albedo_shrinkage) for the
+  // next frame: 1.4826 MAD of log(largest channel / reference) over this frame's due voxels whose
+  // albedo error from the gathered light is at most kSpreadMaxError, where the segment has at
+  // least kMinReferenceVoxels of them; else it keeps its last one.
+  void update_albedo_spreads(int segments);
+  static constexpr float kSpreadMaxError = 0.05f;
   // Fits each segment's unseen irradiance (reflectance/unseen_light.h) to this frame's due
   // voxels that are neither clipped nor under grazing light, and fuses it for the next frames.
   void fit_unseen_light(int segments);
@@ -195,7 +213,12 @@ class ReflectancePipeline {
   std::vector<Eigen::Vector3f> fit_irradiance_, fit_radiance_, grouped_irradiance_,
       grouped_radiance_;
   std::vector<int> segment_starts_, segment_fill_, segment_order_, fit_order_;
+  // Per due voxel: its segment (-1: none) and log brightness over the reference, for
+  // update_albedo_spreads().
+  std::vector<int> spread_segment_;
+  std::vector<float> spread_sample_;
   std::vector<float> albedo_reference_;  // per segment id; NaN: none yet
+  std::vector<float> albedo_spread_;     // per segment id; NaN: none yet
   int frame_ = 0;
 };
 

@@ -456,5 +456,26 @@ TEST(AlbedoRefinement, AVoxelNoLightReachesSamplesTheGathersShortfall) {
       std::isnan(indirect_scale_sample(observe(radiance, {.lit = 0}), gathered, std::nanf(""))));
 }
 
+TEST(AlbedoRefinement, AnAlbedoShrinksTowardsItsSegmentsByTheGathersErrorOverTheSpread) {
+  const Eigen::Vector3f kd(0.6f, 0.3f, 0.15f);  // brightness 0.6
+  const float reference = 0.4f;
+  // No gathered-light error, no spread known or no reference: eq. (7)'s albedo as it is.
+  EXPECT_EQ(shrink_albedo(kd, reference, 0.0f, 0.1f), kd);
+  EXPECT_EQ(shrink_albedo(kd, reference, 0.3f, std::nanf("")), kd);
+  EXPECT_EQ(shrink_albedo(kd, std::nanf(""), 0.3f, 0.1f), kd);
+  // Error equal to the spread: w = 1/2, the brightness at the geometric mean of the voxel's and
+  // the segment's, the colour (channel ratios) kept.
+  const Eigen::Vector3f half = shrink_albedo(kd, reference, 0.1f, 0.1f);
+  EXPECT_NEAR(half.maxCoeff(), std::sqrt(0.6f * reference), 1e-6f);
+  EXPECT_NEAR(half.y() / half.x(), 0.5f, 1e-6f);
+  EXPECT_NEAR(half.z() / half.x(), 0.25f, 1e-6f);
+  // An error far above the spread: the segment's brightness; far below: the voxel's own.
+  EXPECT_NEAR(shrink_albedo(kd, reference, 10.0f, 0.01f).maxCoeff(), reference, 1e-5f);
+  EXPECT_NEAR(shrink_albedo(kd, reference, 1e-4f, 0.5f).maxCoeff(), 0.6f, 1e-5f);
+  // A uniform segment (spread 0): any error takes the segment's brightness; never above 1.
+  EXPECT_NEAR(shrink_albedo(kd, reference, 0.05f, 0.0f).maxCoeff(), reference, 1e-6f);
+  EXPECT_EQ(shrink_albedo(Eigen::Vector3f(0.5f, 0.45f, 0.4f), 3.0f, 1.0f, 0.0f).maxCoeff(), 1.0f);
+}
+
 }  // namespace
 }  // namespace glint::reflectance
