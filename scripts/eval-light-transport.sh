@@ -17,9 +17,11 @@
 #             and the shadow test),
 #   glossy    the same with --indirect-specular sky (the gathered light mirrored by the lobe as
 #             an even sky),
-#   mirror    the defaults: the same with --indirect-specular mirror (the lobe mirrors what its
-#             rays meet),
-# (the variants with the gather but not the lobe's reflection: --indirect-specular off),
+#   mirror    the same with --indirect-specular mirror (the lobe mirrors what its rays meet),
+#   shrinkage the defaults: the same with --albedo-shrinkage on (the refined albedo pulled
+#             towards its segment's by the gather's error),
+# (the variants with the gather but not the lobe's reflection: --indirect-specular off; those
+# with the gather before shrinkage: --albedo-shrinkage off),
 #   before-unseen  --indirect off --unseen-light on,
 #   unseen    --shadows on --shadow-test off --indirect off --unseen-light on,
 #   indirect-unseen  the same with --indirect on --indirect-scale off,
@@ -75,21 +77,24 @@ for scene in $SCENES; do
     reconstruct "$scene" "$r" before --shadows off --indirect off --eval-every 10
     reconstruct "$scene" "$r" after --shadows on --shadow-test off --indirect off --eval-every 10
     reconstruct "$scene" "$r" indirect --shadows on --shadow-test off --indirect on \
-      --indirect-scale off --indirect-specular off --eval-every 10
+      --indirect-scale off --indirect-specular off --albedo-shrinkage off --eval-every 10
     reconstruct "$scene" "$r" scaled --shadows on --shadow-test off --indirect on \
-      --indirect-scale on --indirect-specular off --eval-every 10
+      --indirect-scale on --indirect-specular off --albedo-shrinkage off --eval-every 10
     reconstruct "$scene" "$r" tested --shadows on --shadow-test on --indirect on \
-      --indirect-scale on --indirect-specular off --eval-every 10
+      --indirect-scale on --indirect-specular off --albedo-shrinkage off --eval-every 10
     reconstruct "$scene" "$r" glossy --shadows on --shadow-test on --indirect on \
-      --indirect-scale on --indirect-specular sky --eval-every 10
+      --indirect-scale on --indirect-specular sky --albedo-shrinkage off --eval-every 10
     reconstruct "$scene" "$r" mirror --shadows on --shadow-test on --indirect on \
-      --indirect-scale on --indirect-specular mirror --eval-every 10
+      --indirect-scale on --indirect-specular mirror --albedo-shrinkage off --eval-every 10
+    reconstruct "$scene" "$r" shrinkage --shadows on --shadow-test on --indirect on \
+      --indirect-scale on --indirect-specular mirror --albedo-shrinkage on --eval-every 10
     reconstruct "$scene" "$r" before-unseen --shadows off --indirect off --unseen-light on \
       --eval-every 10
     reconstruct "$scene" "$r" unseen --shadows on --shadow-test off --indirect off \
       --unseen-light on --eval-every 10
     reconstruct "$scene" "$r" indirect-unseen --shadows on --shadow-test off --indirect on \
-      --indirect-scale off --indirect-specular off --unseen-light on --eval-every 10
+      --indirect-scale off --indirect-specular off --albedo-shrinkage off --unseen-light on \
+      --eval-every 10
   done
 done
 for scene in $TIMING_SCENES; do

@@ -15,7 +15,7 @@ import os
 import sys
 
 VARIANTS = ["before", "before-unseen", "after", "indirect", "scaled", "tested", "glossy", "mirror",
-            "unseen", "indirect-unseen"]
+            "shrinkage", "unseen", "indirect-unseen"]
 PAPER_TOTALS = {"2cm": {"cubes": 17.294, "bunnies": 25.023, "office": 29.763},
                 "1cm": {"cubes": 23.919, "bunnies": 44.467, "office": 54.794}}
 STAGES = ["geometry", "observations", "segmentation", "shadows", "indirect", "specular", "mirror",
