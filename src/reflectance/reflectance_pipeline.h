@@ -194,7 +194,8 @@ class ReflectancePipeline {
   // Updates each segment's spread of log brightness (ReflectanceParams::albedo_shrinkage) for the
   // next frame: 1.4826 MAD of log(largest channel / reference) over this frame's due voxels whose
   // albedo error from the gathered light is at most kSpreadMaxError, where the segment has at
-  // least kMinReferenceVoxels of them; else it keeps its last one.
+  // least kMinReferenceVoxels of them; else it keeps its last one. 5 %: voxels lit mostly
+  // directly, whose spread is the segment's texture and noise (not tuned).
   void update_albedo_spreads(int segments);
   static constexpr float kSpreadMaxError = 0.05f;
   // Fits each segment's unseen irradiance (reflectance/unseen_light.h) to this frame's due
