@@ -73,7 +73,7 @@ denoise::DenoiserSettings settings_from(const py::dict& options) {
     const std::string name = py::str(key);
     const auto setter = setters.find(name);
     if (setter == setters.end()) throw Error(name, "", "unknown option of glint.denoise.run");
-    setter->second(value);
+    set_option(name, value, setter->second);
   }
   // The CLI's choices (config is checked by the preset).
   if (s.device != "auto" && s.device != "cpu" && s.device != "cuda")

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "core/error.h"
 #include "core/image.h"
 #include "core/point_cloud.h"
 
@@ -64,5 +65,17 @@ py::array array_from_vectors(std::vector<Vector>&& vectors) {
 
 // A path argument: str or os.PathLike.
 std::string path_from(const py::handle& path);
+
+// Runs set(value) for keyword option `name`; a value of the wrong type (pybind11's cast_error,
+// whose message names neither) becomes glint::Error naming the option and the value.
+template <class Set>
+void set_option(const std::string& name, const py::handle& value, Set&& set) {
+  try {
+    set(value);
+  } catch (const py::cast_error&) {
+    throw Error(name, py::str(py::repr(value)),
+                "wrong type for this option (the docstring lists each option's default)");
+  }
+}
 
 }  // namespace glint::python

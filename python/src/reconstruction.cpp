@@ -95,111 +95,113 @@ reflectance::ReflectanceParams params_from(const py::dict& options, std::string&
   reflectance::ReflectanceParams p;
   p.geometry.device = fusion::IntegrationDevice::automatic;  // the CLI's --device auto
   fusion::VolumeParams& volume = p.geometry.volume;
-  for (const auto& [key, value] : options) {
-    const std::string name = py::str(key);
+  for (const auto& option : options) {
+    const std::string name = py::str(option.first);
     const auto positive = [&](double v) {
       if (!(v > 0)) throw Error(name, "", fmt::format("must be more than 0, got {}", v));
       return v;
     };
-    if (name == "model") {
-      if (!value.is_none()) model = path_from(value);
-    } else if (name == "gt_poses") {
-      p.geometry.use_ground_truth_poses = value.cast<bool>();
-    } else if (name == "exposure") {
-      p.exposure = float(positive(value.cast<double>()));
-    } else if (name == "obs_voxel") {
-      p.observations.voxel_size_m = float(positive(value.cast<double>()));
-    } else if (name == "obs_voxels") {
-      if (!value.is_none())
-        p.observations.voxel_capacity = std::size_t(positive(value.cast<double>()));
-    } else if (name == "obs_spacing") {
-      p.observations.min_observation_spacing_deg = value.cast<float>();
-    } else if (name == "obs_spacing_frames") {
-      p.observations.spacing_max_frames = value.cast<int>();
-    } else if (name == "voxel") {
-      volume.voxel_size_m = positive(value.cast<double>());
-    } else if (name == "trunc") {
-      volume.truncation_m = positive(value.cast<double>());
-    } else if (name == "trunc_per_depth") {
-      volume.truncation_per_depth = value.cast<double>();
-    } else if (name == "depth_max") {
-      volume.depth_max_m = positive(value.cast<double>());
-    } else if (name == "blocks") {
-      volume.block_capacity = std::size_t(positive(value.cast<double>()));
-    } else if (name == "far_every") {
-      volume.far_fusion_every = value.cast<int>();
-    } else if (name == "far_voxel_pixels") {
-      volume.far_voxel_pixels = float(positive(value.cast<double>()));
-    } else if (name == "track_model_halvings") {
-      p.geometry.tracking.model_halvings = value.cast<int>();
-    } else if (name == "device") {
-      const std::string device = value.cast<std::string>();
-      if (device != "cpu" && device != "cuda" && device != "auto")
-        throw Error("device", device, "must be cpu, cuda or auto");
-      p.geometry.device = device == "cpu"    ? fusion::IntegrationDevice::cpu
-                          : device == "cuda" ? fusion::IntegrationDevice::cuda
-                                             : fusion::IntegrationDevice::automatic;
-    } else if (name == "segment_noise") {
-      p.segmentation.convexity_noise_k = value.cast<float>();
-    } else if (name == "albedo_every") {
-      p.albedo_refresh_frames = int(positive(value.cast<int>()));
-    } else if (name == "albedo_average") {
-      p.albedo_average = reflectance::parse_albedo_average(value.cast<std::string>());
-    } else if (name == "albedo_keep_clipped") {
-      p.albedo_keep_clipped = value.cast<bool>();
-    } else if (name == "albedo_min_cosine") {
-      p.albedo_min_light_cosine = value.cast<float>();
-    } else if (name == "albedo_max_indirect") {
-      p.albedo_max_indirect_share = value.cast<float>();
-    } else if (name == "albedo_shrinkage") {
-      p.albedo_shrinkage = value.cast<bool>();
-    } else if (name == "albedo_max_ratio") {
-      p.albedo_max_ratio = value.cast<float>();
-    } else if (name == "albedo_smoothing") {
-      p.albedo_smoothing = value.cast<float>();
-    } else if (name == "specular") {
-      const std::string specular = value.cast<std::string>();
-      if (specular != "hemicnn" && specular != "hemicnn+fit")
-        throw Error("specular", specular, "must be hemicnn or hemicnn+fit");
-      p.specular.fit_lobe = specular == "hemicnn+fit";
-    } else if (name == "normals") {
-      const std::string normals = value.cast<std::string>();
-      if (normals != "gradient" && normals != "plane")
-        throw Error("normals", normals, "must be gradient or plane");
-      p.observations.normal_from_neighbours = normals == "plane";
-    } else if (name == "shadows") {
-      p.light_transport.shadows = value.cast<bool>();
-    } else if (name == "shadow_test") {
-      p.light_transport.shadow_test = value.cast<bool>();
-    } else if (name == "shadow_test_sigmas") {
-      p.light_transport.shadow_test_sigmas = value.cast<float>();
-    } else if (name == "indirect") {
-      p.light_transport.indirect = value.cast<bool>();
-    } else if (name == "unseen_light") {
-      p.light_transport.unseen = value.cast<bool>();
-    } else if (name == "indirect_rays") {
-      const int rays = value.cast<int>();
-      if (rays < 1 || rays > 65535)
-        throw Error(name, "", fmt::format("must be in [1, 65535], got {}", rays));
-      p.light_transport.indirect_rays = rays;
-    } else if (name == "indirect_rays_per_frame") {
-      p.light_transport.indirect_rays_per_frame = int(positive(value.cast<int>()));
-    } else if (name == "indirect_pooling") {
-      p.light_transport.indirect_pooling = value.cast<bool>();
-    } else if (name == "indirect_scale") {
-      p.light_transport.indirect_scaled = value.cast<bool>();
-    } else if (name == "indirect_specular") {
-      p.light_transport.indirect_specular =
-          reflectance::parse_indirect_specular(value.cast<std::string>());
-    } else if (name == "ray_offset") {
-      p.light_transport.ray_offset_m = value.cast<float>();
-    } else if (name == "seed") {
-      p.specular.seed = p.segments.seed = value.cast<std::uint64_t>();
-    } else if (name == "render_normal_radius") {
-      render_normal_radius = value.cast<float>();
-    } else {
-      throw Error(name, "", "unknown option of glint.Reconstruction");
-    }
+    set_option(name, option.second, [&](const py::handle& value) {
+      if (name == "model") {
+        if (!value.is_none()) model = path_from(value);
+      } else if (name == "gt_poses") {
+        p.geometry.use_ground_truth_poses = value.cast<bool>();
+      } else if (name == "exposure") {
+        p.exposure = float(positive(value.cast<double>()));
+      } else if (name == "obs_voxel") {
+        p.observations.voxel_size_m = float(positive(value.cast<double>()));
+      } else if (name == "obs_voxels") {
+        if (!value.is_none())
+          p.observations.voxel_capacity = std::size_t(positive(value.cast<double>()));
+      } else if (name == "obs_spacing") {
+        p.observations.min_observation_spacing_deg = value.cast<float>();
+      } else if (name == "obs_spacing_frames") {
+        p.observations.spacing_max_frames = value.cast<int>();
+      } else if (name == "voxel") {
+        volume.voxel_size_m = positive(value.cast<double>());
+      } else if (name == "trunc") {
+        volume.truncation_m = positive(value.cast<double>());
+      } else if (name == "trunc_per_depth") {
+        volume.truncation_per_depth = value.cast<double>();
+      } else if (name == "depth_max") {
+        volume.depth_max_m = positive(value.cast<double>());
+      } else if (name == "blocks") {
+        volume.block_capacity = std::size_t(positive(value.cast<double>()));
+      } else if (name == "far_every") {
+        volume.far_fusion_every = value.cast<int>();
+      } else if (name == "far_voxel_pixels") {
+        volume.far_voxel_pixels = float(positive(value.cast<double>()));
+      } else if (name == "track_model_halvings") {
+        p.geometry.tracking.model_halvings = value.cast<int>();
+      } else if (name == "device") {
+        const std::string device = value.cast<std::string>();
+        if (device != "cpu" && device != "cuda" && device != "auto")
+          throw Error("device", device, "must be cpu, cuda or auto");
+        p.geometry.device = device == "cpu"    ? fusion::IntegrationDevice::cpu
+                            : device == "cuda" ? fusion::IntegrationDevice::cuda
+                                               : fusion::IntegrationDevice::automatic;
+      } else if (name == "segment_noise") {
+        p.segmentation.convexity_noise_k = value.cast<float>();
+      } else if (name == "albedo_every") {
+        p.albedo_refresh_frames = int(positive(value.cast<int>()));
+      } else if (name == "albedo_average") {
+        p.albedo_average = reflectance::parse_albedo_average(value.cast<std::string>());
+      } else if (name == "albedo_keep_clipped") {
+        p.albedo_keep_clipped = value.cast<bool>();
+      } else if (name == "albedo_min_cosine") {
+        p.albedo_min_light_cosine = value.cast<float>();
+      } else if (name == "albedo_max_indirect") {
+        p.albedo_max_indirect_share = value.cast<float>();
+      } else if (name == "albedo_shrinkage") {
+        p.albedo_shrinkage = value.cast<bool>();
+      } else if (name == "albedo_max_ratio") {
+        p.albedo_max_ratio = value.cast<float>();
+      } else if (name == "albedo_smoothing") {
+        p.albedo_smoothing = value.cast<float>();
+      } else if (name == "specular") {
+        const std::string specular = value.cast<std::string>();
+        if (specular != "hemicnn" && specular != "hemicnn+fit")
+          throw Error("specular", specular, "must be hemicnn or hemicnn+fit");
+        p.specular.fit_lobe = specular == "hemicnn+fit";
+      } else if (name == "normals") {
+        const std::string normals = value.cast<std::string>();
+        if (normals != "gradient" && normals != "plane")
+          throw Error("normals", normals, "must be gradient or plane");
+        p.observations.normal_from_neighbours = normals == "plane";
+      } else if (name == "shadows") {
+        p.light_transport.shadows = value.cast<bool>();
+      } else if (name == "shadow_test") {
+        p.light_transport.shadow_test = value.cast<bool>();
+      } else if (name == "shadow_test_sigmas") {
+        p.light_transport.shadow_test_sigmas = value.cast<float>();
+      } else if (name == "indirect") {
+        p.light_transport.indirect = value.cast<bool>();
+      } else if (name == "unseen_light") {
+        p.light_transport.unseen = value.cast<bool>();
+      } else if (name == "indirect_rays") {
+        const int rays = value.cast<int>();
+        if (rays < 1 || rays > 65535)
+          throw Error(name, "", fmt::format("must be in [1, 65535], got {}", rays));
+        p.light_transport.indirect_rays = rays;
+      } else if (name == "indirect_rays_per_frame") {
+        p.light_transport.indirect_rays_per_frame = int(positive(value.cast<int>()));
+      } else if (name == "indirect_pooling") {
+        p.light_transport.indirect_pooling = value.cast<bool>();
+      } else if (name == "indirect_scale") {
+        p.light_transport.indirect_scaled = value.cast<bool>();
+      } else if (name == "indirect_specular") {
+        p.light_transport.indirect_specular =
+            reflectance::parse_indirect_specular(value.cast<std::string>());
+      } else if (name == "ray_offset") {
+        p.light_transport.ray_offset_m = value.cast<float>();
+      } else if (name == "seed") {
+        p.specular.seed = p.segments.seed = value.cast<std::uint64_t>();
+      } else if (name == "render_normal_radius") {
+        render_normal_radius = value.cast<float>();
+      } else {
+        throw Error(name, "", "unknown option of glint.Reconstruction");
+      }
+    });
   }
   return p;
 }

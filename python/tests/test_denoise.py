@@ -56,5 +56,7 @@ def test_denoise_errors(noisy_png):
         glint.denoise.run(image, guidance=np.ones((5, 5), np.float32))
     with pytest.raises(glint.Error, match="colour: unknown option of glint.denoise.run"):
         glint.denoise.run(image, method="nlm", colour=1)
+    with pytest.raises(glint.Error, match="nlm_h: 'strong': wrong type for this option"):
+        glint.denoise.run(image, method="nlm", nlm_h="strong")
     with pytest.raises(glint.Error, match="patch"):
         glint.denoise.noise_map(image, patch=4)
