@@ -118,24 +118,36 @@ std::uint64_t place_hash(const Eigen::Vector3i& place) {
              std::uint64_t(std::uint32_t(place.z())) << 42);
 }
 
-// Queues voxel v's next `rays` gather rays: cosine-weighted directions from its sequence, whose
-// index `next` advances. The sequence is the additive recurrence of the plastic number (Roberts'
-// R2): low-discrepancy in [0, 1)^2 for any number of points, so a voxel's directions stratify
-// however many it has been given; each voxel's sequence is shifted (Cranley-Patterson) by a hash
-// of its place.
+// The additive recurrence of the plastic number (Roberts' R2): low-discrepancy in [0, 1)^2 for
+// any number of points, so a point's first n directions stratify whatever n is; shifted
+// (Cranley-Patterson) by a hash, so that each voxel or pixel has its own.
+class ShiftedR2 {
+ public:
+  explicit ShiftedR2(std::uint64_t hash)
+      : shift_a_(float(hash >> 40) * 0x1p-24f),
+        shift_b_(float((hash >> 16) & 0xFFFFFF) * 0x1p-24f) {}
+  // Point `index` of the sequence (an integer below 2^22, exact in a float).
+  Eigen::Vector2f operator()(float index) const {
+    constexpr float kR2a = 0.75487766624669276f, kR2b = 0.56984029099805327f;
+    return {fraction(shift_a_ + index * kR2a), fraction(shift_b_ + index * kR2b)};
+  }
+
+ private:
+  float shift_a_, shift_b_;
+};
+
+// Queues voxel v's next `rays` gather rays: cosine-weighted directions from its ShiftedR2
+// sequence (hashed by its place), whose index `next` advances.
 void queue_gather_rays(const ObservationGrid& grid, int v, int rays,
                        const LightTransportParams& params, const WorldBox& box, std::uint32_t& next,
                        fusion::RayQueue& queue) {
-  constexpr float kR2a = 0.75487766624669276f, kR2b = 0.56984029099805327f;
   const Eigen::Vector3f& normal = grid.normal(v);
   const Eigen::Matrix3f to_world = local_frame(normal).transpose();
   const Eigen::Vector3f origin = grid.position(v) + params.ray_offset_m * normal;
-  const std::uint64_t hash = mix(params.seed ^ place_hash(grid.voxel_coordinates(v)));
-  const float shift_a = float(hash >> 40) * 0x1p-24f;
-  const float shift_b = float((hash >> 16) & 0xFFFFFF) * 0x1p-24f;
+  const ShiftedR2 sequence(mix(params.seed ^ place_hash(grid.voxel_coordinates(v))));
   for (int k = 0; k < rays; ++k) {
-    const float index = float(next++ % (1u << 22));
-    const float u1 = fraction(shift_a + index * kR2a), u2 = fraction(shift_b + index * kR2b);
+    const Eigen::Vector2f u = sequence(float(next++ % (1u << 22)));
+    const float u1 = u.x(), u2 = u.y();
     const float radius = std::sqrt(u1), phi = 2 * float(M_PI) * u2;
     const Eigen::Vector3f direction =
         to_world * Eigen::Vector3f(radius * std::cos(phi), radius * std::sin(phi),
@@ -166,19 +178,17 @@ bool gathered_radiance(const fusion::RayQueue& queue, int ray, const Observation
 
 // Queues `rays` rays from p (unit normal n) drawn from eq. (3)'s lobe for the view along unit
 // wo (towards the viewer): half vectors by Walter's sampling (render/ward_sampling.h), each
-// mirroring wo, stratified by the R2 sequence shifted by `hash`; those below the surface are not
-// queued. Returns how many were.
+// mirroring wo, stratified by ShiftedR2(hash); those below the surface are not queued. Returns
+// how many were.
 int queue_lobe_rays(fusion::RayQueue& queue, int rays, const Eigen::Vector3f& p,
                     const Eigen::Vector3f& n, const Eigen::Vector3f& wo, float alpha,
                     std::uint64_t hash, const LightTransportParams& params, const WorldBox& box) {
-  constexpr float kR2a = 0.75487766624669276f, kR2b = 0.56984029099805327f;
   const Eigen::Vector3f origin = p + params.ray_offset_m * n;
-  const float shift_a = float(hash >> 40) * 0x1p-24f;
-  const float shift_b = float((hash >> 16) & 0xFFFFFF) * 0x1p-24f;
+  const ShiftedR2 sequence(hash);
   int queued = 0;
   for (int k = 0; k < rays; ++k) {
-    const Eigen::Vector3f h = render::sample_ward_half_vector(
-        n, alpha, fraction(shift_a + float(k) * kR2a), fraction(shift_b + float(k) * kR2b));
+    const Eigen::Vector2f u = sequence(float(k));
+    const Eigen::Vector3f h = render::sample_ward_half_vector(n, alpha, u.x(), u.y());
     const Eigen::Vector3f wi = (2 * wo.dot(h) * h - wo).normalized();
     if (!(n.dot(wi) > 0)) continue;
     queue.add(origin, wi, std::min(params.indirect_max_distance_m, box.exit(origin, wi)));
@@ -186,6 +196,10 @@ int queue_lobe_rays(fusion::RayQueue& queue, int rays, const Eigen::Vector3f& p,
   }
   return queued;
 }
+
+// What a slot's MirrorSample remembers of the observation its ray was cast for: frame + 1 (0: no
+// ray yet), so a newer observation in the slot is told apart.
+std::uint32_t mirror_tag(const Observation& observation) { return observation.frame() + 1; }
 
 // Lobe rays per stored observation: eq. (7) takes a median over a voxel's observations, which
 // averages their one ray each. (Per re-rendered pixel: LightTransport::kPixelLobeRays.)
@@ -480,7 +494,7 @@ void LightTransport::update_mirrors(const ObservationGrid& grid, const fusion::T
         const Eigen::Vector3f& normal = grid.normal(v);
         for (int k = 0; k < grid.observation_count(v); ++k) {
           const std::size_t slot = grid.first_slot(v) + std::size_t(k);
-          const std::uint32_t tag = observations[k].frame() + 1;
+          const std::uint32_t tag = mirror_tag(observations[k]);
           if (mirror_[slot].tag == tag) continue;
           mirror_[slot] = {.tag = tag};
           const Eigen::Vector3f view = observations[k].direction();
@@ -516,7 +530,7 @@ std::span<const Eigen::Vector3f> LightTransport::mirrored(
   for (int k = 0; k < count; ++k) {
     const MirrorSample& sample = mirror_[grid.first_slot(v) + std::size_t(k)];
     Eigen::Vector3f& out = radiance[std::size_t(k)];
-    if (!sample.known || sample.tag != observations[k].frame() + 1) {
+    if (!sample.known || sample.tag != mirror_tag(observations[k])) {
       out = Eigen::Vector3f::Constant(NAN);
       continue;
     }
