@@ -68,6 +68,12 @@ namespace glint::reflectance {
 //    glossy object's lower half, the dark above it. One ray per stored observation, cast once
 //    (LightTransport::update_mirrors()), and kPixelLobeRays per re-rendered pixel.
 enum class IndirectSpecular { off, sky, mirror };
+// With mirror, a lobe this weak (ks below kMirrorMinKs in every channel: walls, floors) mirrors the
+// even sky instead: its rays cost as much as a glossy lobe's, and what they would change is ks
+// times the departure of a radiance from the sky's (docs/decisions.md, "Lobe rays where the lobe
+// is strong enough to matter").
+inline constexpr float kMirrorMinKs = 0.05f;
+inline bool casts_lobe_rays(const Eigen::Vector3f& ks) { return ks.maxCoeff() >= kMirrorMinKs; }
 const char* indirect_specular_name(IndirectSpecular mode);
 // Throws glint::Error for a name other than off, sky, mirror.
 IndirectSpecular parse_indirect_specular(const std::string& name);
@@ -202,7 +208,8 @@ class LightTransport {
 
   // With IndirectSpecular::mirror: casts the lobe rays of the stored observations of `voxels` that
   // have none yet (a slot's rays are cast again once a newer observation has taken the slot), drawn
-  // from eq. (3)'s lobe of width alpha(voxel) (voxels of alpha 0 are left out).
+  // from eq. (3)'s lobe of width alpha(voxel) (voxels of alpha 0 are left out: they mirror the
+  // even sky, as weak lobes do, casts_lobe_rays()).
   void update_mirrors(const ObservationGrid& grid, const fusion::TsdfVolume& volume,
                       const fusion::BlockOccupancy& occupancy,
                       const std::vector<render::PointLight>& lights, std::span<const int> voxels,
@@ -376,7 +383,7 @@ class PointLightingQuery {
         lights_(lights),
         rays_(volume, &occupancy) {}
   // With IndirectSpecular::mirror, `eye` (the viewpoint) and the lobe's width `alpha` give the lobe
-  // rays whose radiance it reflects (PointLighting::indirect_radiance).
+  // rays whose radiance it reflects (PointLighting::indirect_radiance); alpha 0: the even sky.
   PointLighting operator()(const Eigen::Vector3f& p, const Eigen::Vector3f& n,
                            const Eigen::Vector3f& eye, float alpha);
 

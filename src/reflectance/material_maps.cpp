@@ -445,7 +445,9 @@ void render_material_maps(const fusion::SurfaceView& surface, const Pose& camera
       };
       // The two materials differ in kd only: one shading serves both.
       PointLighting light_here =
-          lighting ? (*lighting)(p, n, eye, material.fused.alpha) : PointLighting{};
+          lighting ? (*lighting)(p, n, eye,
+                                 casts_lobe_rays(material.fused.ks) ? material.fused.alpha : 0.0f)
+                   : PointLighting{};
       light_here.direct_share = material.direct_share;
       const WardShading shading = ward_shading(material.fused.alpha, p, n, eye, lights, light_here);
       put(maps.rgb, x, y, pixel(shading.radiance(material.fused)));

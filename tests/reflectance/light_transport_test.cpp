@@ -495,6 +495,26 @@ TEST(LightTransport, AnObservationsLobeRaysMeetWhatItsMirrorDirectionSees) {
   EXPECT_THROW(parse_indirect_specular("on"), Error);
 }
 
+// A lobe weaker than kMirrorMinKs in every channel casts no rays: the pipeline hands it alpha 0,
+// its observations' mirrored radiance stays unknown (NaN), and eq. (7) takes the even sky
+// (PointLighting::indirect_radiance) in its place; one channel at the threshold casts them.
+TEST(LightTransport, AWeakLobeCastsNoRaysAndMirrorsTheEvenSky) {
+  EXPECT_FALSE(casts_lobe_rays(Eigen::Vector3f(0.04f, 0.02f, 0.0499f)));
+  EXPECT_TRUE(casts_lobe_rays(Eigen::Vector3f(0.01f, kMirrorMinKs, 0.01f)));
+  const WallBesideFloor scene;
+  LightTransportParams params{.shadows = false, .indirect = true};
+  params.indirect_scaled = false;
+  const LightTransport transport = scene.mirror(params, 0.0f);
+  std::array<Eigen::Vector3f, kMaxObservationsPerVoxel> mirrored;
+  int observations = 0;
+  for (const int v : scene.floor_voxels())
+    for (const Eigen::Vector3f& radiance : transport.mirrored(scene.grid(), v, mirrored)) {
+      EXPECT_TRUE(radiance.array().isNaN().all());
+      ++observations;
+    }
+  EXPECT_GT(observations, 40);
+}
+
 // The scaled gather's error at one voxel: the spread of the scale's samples about their median,
 // 1.4826 MAD / median (a normal distribution's standard deviation, relative).
 TEST(LightTransport, TheGathersErrorIsTheSpreadOfTheScaleSamples) {
