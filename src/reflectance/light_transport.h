@@ -49,6 +49,7 @@
 #include "reflectance/observation_grid.h"
 #include "reflectance/unseen_light.h"
 #include "render/scene.h"
+#include "render/ward.h"
 
 namespace glint::render {
 class EmbreeScene;
@@ -74,6 +75,11 @@ enum class IndirectSpecular { off, sky, mirror };
 // is strong enough to matter").
 inline constexpr float kMirrorMinKs = 0.05f;
 inline bool casts_lobe_rays(const Eigen::Vector3f& ks) { return ks.maxCoeff() >= kMirrorMinKs; }
+// The lobe width a material's lobe rays are drawn with (update_mirrors(), PointLightingQuery):
+// its alpha, or 0 (no rays, the even sky) for a weak lobe.
+inline float lobe_ray_alpha(const render::WardMaterial& material) {
+  return casts_lobe_rays(material.ks) ? material.alpha : 0.0f;
+}
 const char* indirect_specular_name(IndirectSpecular mode);
 // Throws glint::Error for a name other than off, sky, mirror.
 IndirectSpecular parse_indirect_specular(const std::string& name);

@@ -445,9 +445,7 @@ void render_material_maps(const fusion::SurfaceView& surface, const Pose& camera
       };
       // The two materials differ in kd only: one shading serves both.
       PointLighting light_here =
-          lighting ? (*lighting)(p, n, eye,
-                                 casts_lobe_rays(material.fused.ks) ? material.fused.alpha : 0.0f)
-                   : PointLighting{};
+          lighting ? (*lighting)(p, n, eye, lobe_ray_alpha(material.fused)) : PointLighting{};
       light_here.direct_share = material.direct_share;
       const WardShading shading = ward_shading(material.fused.alpha, p, n, eye, lights, light_here);
       put(maps.rgb, x, y, pixel(shading.radiance(material.fused)));

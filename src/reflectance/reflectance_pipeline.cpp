@@ -391,7 +391,7 @@ ReflectanceFrame ReflectancePipeline::process(const io::RgbdFrame& frame,
     transport_.update_mirrors(
         grid_, geometry_.volume(), *occupancy, lights_, albedo_due_, [&](int v) {
           const SegmentMaterial* material = specular_.material(grid_.segment(v));
-          return material && casts_lobe_rays(material->ward.ks) ? material->ward.alpha : 0.0f;
+          return material ? lobe_ray_alpha(material->ward) : 0.0f;
         });
     timings_.add("mirror", stage.elapsed_ms());
     stage.restart();
