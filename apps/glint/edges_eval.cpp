@@ -107,14 +107,17 @@ void run_eval(EvalOptions options) {
       file_json["scores"][method]["seconds"] = seconds;
     };
     try {
-      // Models with the same scales share one feature matrix (features dominate the time).
-      std::map<std::vector<int>, std::pair<edges::FeatureMatrix, double>> features_by_scales;
+      // Models with the same scales and inputs share one feature matrix (features dominate
+      // the time).
+      std::map<std::pair<std::vector<int>, bool>, std::pair<edges::FeatureMatrix, double>>
+          features_by_inputs;
       for (const auto& [method, model] : models) {
-        auto [entry, is_new] = features_by_scales.try_emplace(model.config.scales);
+        auto [entry, is_new] =
+            features_by_inputs.try_emplace({model.config.scales, model.config.angular_gap});
         auto& [features, features_s] = entry->second;
         if (is_new) {
           const Stopwatch watch;
-          features = edges::compute_features(cloud, edges::FeatureParams{model.config.scales});
+          features = edges::compute_features(cloud, model.config.feature_params());
           features_s = watch.elapsed_s();
         }
         const edges::Classification result = edges::classify_features(features, model);

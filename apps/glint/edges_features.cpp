@@ -20,19 +20,21 @@ struct FeaturesOptions {
   std::string input;
   std::string output;
   std::vector<int> scales{128, 64, 32, 16};
+  bool angular_gap = false;
 };
 
-constexpr std::array<const char*, edges::kFeaturesPerScale> kFeatureNames = {
-    "sigma_upper1", "sigma_upper2", "sigma_upper3", "sigma_lower1", "sigma_lower2", "sigma_lower3",
-    "d_perp",       "d_parallel",   "s_perp",       "s_parallel",   "c_perp",       "c_parallel"};
+constexpr std::array<const char*, edges::kThesisFeaturesPerScale + 1> kFeatureNames = {
+    "sigma_upper1", "sigma_upper2", "sigma_upper3", "sigma_lower1", "sigma_lower2",
+    "sigma_lower3", "d_perp",       "d_parallel",   "s_perp",       "s_parallel",
+    "c_perp",       "c_parallel",   "angular_gap"};
 
 void write_csv(const std::string& path, const edges::FeatureMatrix& features,
                const std::vector<int>& scales) {
   io::AtomicFile file(path, false);
   std::ostream& out = file.stream();
   for (std::size_t s = 0; s < scales.size(); ++s) {
-    for (std::size_t f = 0; f < kFeatureNames.size(); ++f) {
-      out << (s + f == 0 ? "" : ",") << "k" << scales[s] << "_" << kFeatureNames[f];
+    for (int f = 0; f < features.per_scale; ++f) {
+      out << (s == 0 && f == 0 ? "" : ",") << "k" << scales[s] << "_" << kFeatureNames[f];
     }
   }
   out << "\n";
@@ -52,6 +54,7 @@ void run_features(const FeaturesOptions& options) {
   const PointCloud cloud = io::read_point_cloud(options.input);
   edges::FeatureParams params;
   params.scales = options.scales;
+  params.angular_gap = options.angular_gap;
   edges::FeatureMatrix features;
   try {
     features = edges::compute_features(cloud, params);
@@ -64,7 +67,7 @@ void run_features(const FeaturesOptions& options) {
     write_csv(options.output, features, options.scales);
   }
   fmt::print("{}: {} points x {} scales x {} features -> {}\n", options.input, features.points,
-             features.scales, edges::kFeaturesPerScale, options.output);
+             features.scales, features.per_scale, options.output);
 }
 
 }  // namespace
@@ -75,7 +78,8 @@ void register_edges_features(CLI::App& edges) {
       "features",
       "Compute BoundED's multi-scale neighbourhood features (thesis eqs. 5.1-5.21): per point\n"
       "and scale sigma_upper(3), sigma_lower(3), d_perp, d_parallel, s_perp, s_parallel,\n"
-      "c_perp, c_parallel, in the normalised frame of eq. 5.4. Columns are scale-major.\n"
+      "c_perp, c_parallel, in the normalised frame of eq. 5.4 (with --angular-gap also\n"
+      "angular_gap). Columns are scale-major.\n"
       "Example: glint edges features cloud.ply -o cloud_features.npy");
   command->add_option("input", options->input, "Input point cloud")->required();
   command->add_option("-o,--output", options->output, "Output .npy (float32) or .csv")
@@ -84,6 +88,10 @@ void register_edges_features(CLI::App& edges) {
   command->add_option("--scales", options->scales, "Neighbourhood sizes, largest first")
       ->delimiter(',')
       ->capture_default_str();
+  command->add_flag("--angular-gap", options->angular_gap,
+                    "Add angular_gap per scale: the largest empty sector of the neighbours around "
+                    "the normal, as a fraction of the turn (the shipped 3-class model's 13th "
+                    "input)");
   command->callback([options] { run_features(*options); });
 }
 

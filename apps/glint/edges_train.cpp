@@ -76,12 +76,15 @@ nlohmann::json add_cloud(const std::string& file, const edges::ModelConfig& conf
   edges::FeatureMatrix features;
   {
     ScopedStage stage(timings, "features");
-    features = edges::compute_features(cloud, edges::FeatureParams{config.scales});
+    features = edges::compute_features(cloud, config.feature_params());
   }
   log().info("{}: {} points ({} non-edge, {} sharp, {} boundary)", file, cloud.size(), counts[0],
              counts[1], counts[2]);
 
-  if (set.features.points == 0) set.features.scales = features.scales;
+  if (set.features.points == 0) {
+    set.features.scales = features.scales;
+    set.features.per_scale = features.per_scale;
+  }
   set.features.points += features.points;
   set.features.values.insert(set.features.values.end(), features.values.begin(),
                              features.values.end());
@@ -172,6 +175,10 @@ void register_edges_train(CLI::App& edges) {
                    "Neighbourhood sizes k, largest first; a power of two of them")
       ->delimiter(',')
       ->capture_default_str();
+  command->add_flag("--angular-gap", options->config.angular_gap,
+                    "Add a thirteenth input per scale: the largest empty sector of the neighbours "
+                    "around the normal (PCL's boundary rule, graded; the shipped 3-class model "
+                    "has it)");
   command
       ->add_option("--exclude", options->exclude,
                    "Skip files whose name contains PATTERN; repeat the flag for more patterns "

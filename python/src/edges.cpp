@@ -36,9 +36,10 @@ py::tuple classify(const py::object& xyz, const py::object& model, const py::obj
                         array_from_vector(std::move(probs), {py::ssize_t(n), 2}));
 }
 
-py::array features(const py::object& xyz, const py::object& scales_arg) {
+py::array features(const py::object& xyz, const py::object& scales_arg, bool angular_gap) {
   edges::FeatureParams params;
   if (!scales_arg.is_none()) params.scales = scales_from(scales_arg);
+  params.angular_gap = angular_gap;
   const PointCloud cloud = cloud_from_array(xyz, "xyz");
   edges::FeatureMatrix matrix;
   {
@@ -77,17 +78,20 @@ Raises:
 
 The GIL is released while the features and the network run.)");
   m.def("features", &features, py::arg("xyz"), py::arg("scales") = py::none(),
+        py::arg("angular_gap") = false,
         R"(BoundED's multi-scale neighbourhood features (thesis eqs. 5.1-5.21), as
 `glint edges features`.
 
 Args:
     xyz: (N, 3) float32 or float64 positions (copied once, as in classify).
     scales: neighbourhood sizes, largest first; None = [128, 64, 32, 16], the CLI's default.
+    angular_gap: also angular_gap per scale (the largest empty sector of the neighbours
+        around the normal, as a fraction of the turn), as `--angular-gap`.
 
 Returns:
-    (N, 12 * len(scales)) float32, scale-major: per scale sigma_upper1..3, sigma_lower1..3,
-    d_perp, d_parallel, s_perp, s_parallel, c_perp, c_parallel. The array owns the C++
-    result (no copy).
+    (N, F * len(scales)) float32, scale-major, F = 12 (13 with angular_gap): per scale
+    sigma_upper1..3, sigma_lower1..3, d_perp, d_parallel, s_perp, s_parallel, c_perp,
+    c_parallel[, angular_gap]. The array owns the C++ result (no copy).
 
 Raises:
     glint.Error: bad array, bad scales (each >= 3, largest first), too few points.)");

@@ -77,6 +77,14 @@ def test_features_equal_cli(cloud_file, cli, tmp_path):
     assert features.shape == (len(xyz), 24) and features.dtype == np.float32
     np.testing.assert_array_equal(features, np.load(out))
 
+    cli("edges", "features", cloud_file, "-o", out, "--scales", "32,16", "--angular-gap")
+    with_gap = glint.edges.features(xyz, scales=[32, 16], angular_gap=True)
+    assert with_gap.shape == (len(xyz), 26)
+    np.testing.assert_array_equal(with_gap, np.load(out))
+    # The thesis's twelve values per scale, then the gap, a fraction of the turn.
+    np.testing.assert_array_equal(with_gap[:, [*range(12), *range(13, 25)]], features)
+    assert ((with_gap[:, [12, 25]] >= 0) & (with_gap[:, [12, 25]] <= 1)).all()
+
 
 def test_bad_inputs_raise_glint_error():
     with pytest.raises(glint.Error, match=r"xyz: must be an \(N, 3\) array of positions, got "

@@ -46,8 +46,9 @@ std::vector<Classification> run_networks(const PointCloud& cloud,
                                          std::vector<std::uint8_t>* quiet) {
   FeatureParams params;
   params.scales = scales;
+  params.angular_gap = networks.front()->config.angular_gap;
   const int scale_count = static_cast<int>(scales.size());
-  const std::size_t row_size = std::size_t(scale_count) * kFeaturesPerScale;
+  const std::size_t row_size = std::size_t(scale_count) * std::size_t(params.per_scale());
   const std::size_t classes = static_cast<std::size_t>(networks.front()->config.classes);
   std::vector<Classification> results;
   for (std::size_t n = 0; n < networks.size(); ++n) results.push_back(sized_result(cloud.size()));
@@ -83,7 +84,8 @@ std::vector<Classification> run_networks(const PointCloud& cloud,
         }
         if (quiet)
           for (std::size_t b = 0; b < count; ++b)
-            (*quiet)[points[b]] = noise_statistic(rows + b * row_size, scale_count) < threshold;
+            (*quiet)[points[b]] =
+                noise_statistic(rows + b * row_size, scale_count, params.per_scale()) < threshold;
         worker.network_s += network_watch.elapsed_s();
       });
   const double total_s = watch.elapsed_s();
@@ -137,8 +139,8 @@ Classification classify_features(const FeatureMatrix& features, const Model& mod
   if (model.gated()) {
     model.check_features(features);
     for (std::size_t i = 0; i < features.points; ++i)
-      result.quiet_points +=
-          noise_statistic(features.row(i), features.scales) < model.noise_threshold;
+      result.quiet_points += noise_statistic(features.row(i), features.scales, features.per_scale) <
+                             model.noise_threshold;
     result.low_noise_network = Model::low_noise_answers(result.quiet_points, features.points);
     if (result.low_noise_network) network = model.low_noise.get();
   }

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <tbb/enumerable_thread_specific.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -61,6 +62,7 @@ struct Scratch {
   static constexpr int kBuckets = 64;
   std::vector<float> squared_distances;
   std::vector<std::uint8_t> bucket_of;
+  std::vector<std::int32_t> sector_of;
   std::vector<std::uint64_t> straddling;
   // Rows handed out in blocks (compute_features_in_blocks): the block's points and rows.
   std::vector<std::uint32_t> block_points;
@@ -151,11 +153,57 @@ Moments moments_nearest_to(const geometry::Neighbourhood& nb, int k, const Vecto
   return nearest;
 }
 
+// Angle of (a, b) in (-pi, pi], polynomial (error ~1e-5 rad), branch-free so it vectorises.
+float fast_atan2(float b, float a) {
+  const float ax = std::abs(a), ay = std::abs(b);
+  const float t = std::min(ax, ay) / std::max(std::max(ax, ay), 1e-30f);
+  const float s = t * t;
+  float r = ((-0.0464964749f * s + 0.15931422f) * s - 0.327622764f) * s * t + t;
+  r = ay > ax ? 1.57079637f - r : r;
+  r = a < 0 ? 3.14159274f - r : r;
+  return b < 0 ? -r : r;
+}
+
+// The angular gap (features.h): the largest empty sector of neighbours [1, k) around `normal`,
+// as a fraction of the turn. The sectors are found in a loop that vectorises, then gathered
+// into one word.
+float largest_angular_gap(const geometry::Neighbourhood& nb, int k, const Vector3d& normal,
+                          double spread, Scratch& scratch) {
+  constexpr int kSectors = 64, kNoSector = kSectors;
+  const Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
+  const float ux = float(u.x()), uy = float(u.y()), uz = float(u.z());
+  const float vx = float(v.x()), vy = float(v.y()), vz = float(v.z());
+  const float tiny = float(1e-6 * spread) * float(1e-6 * spread);
+  scratch.sector_of.resize(std::size_t(k));
+  std::int32_t* sector_of = scratch.sector_of.data();
+  const float* dx = nb.dx;
+  const float* dy = nb.dy;
+  const float* dz = nb.dz;
+  // From j = 0: the query itself projects to 0 and counts as no sector; k stays a multiple of
+  // the vector width at the default scales, so no scalar remainder runs.
+  for (int j = 0; j < k; ++j) {
+    const float a = dx[j] * ux + dy[j] * uy + dz[j] * uz;
+    const float b = dx[j] * vx + dy[j] * vy + dz[j] * vz;
+    const int sector = std::min(kSectors - 1, int((fast_atan2(b, a) + 3.14159274f) *
+                                                  float(kSectors / (2 * 3.14159265358979))));
+    sector_of[j] = a * a + b * b > tiny ? sector : kNoSector;
+  }
+  std::uint64_t occupied = 0;
+  for (int j = 0; j < k; ++j)
+    occupied |= std::uint64_t(sector_of[j] != kNoSector) << (sector_of[j] & (kSectors - 1));
+  if (occupied == 0) return 1.0f;
+  // Rotated so that sector 0 is occupied, no empty run wraps around.
+  std::uint64_t empty = ~std::rotr(occupied, std::countr_zero(occupied));
+  int longest = 0;
+  for (; empty != 0; ++longest) empty &= empty << 1;
+  return float(longest) / float(kSectors);
+}
+
 // The twelve features of one scale, eqs. (5.9)-(5.18); `upper_sigma` and `lower_sigma` are the
 // subsets' covariance eigenvalues. Positions are relative to the query point (the origin).
 void scale_features(const ScaleState& state, const ScaleState& largest, const Vector3d& upper_sigma,
                     const Vector3d& lower_sigma, float* out) {
-  std::fill(out, out + kFeaturesPerScale, 0.0f);
+  std::fill(out, out + kThesisFeaturesPerScale, 0.0f);
   if (!(state.spread > 0) || !std::isfinite(state.spread)) return;  // all neighbours coincide
   const double scale = 2.0 / state.spread;                          // eq. (5.4)
   // Moments were gathered in the query frame and are normalised here (mean: (m - centre)·scale,
@@ -184,9 +232,11 @@ void scale_features(const ScaleState& state, const ScaleState& largest, const Ve
 // All scales of one point. The neighbour list is ordered nearest first, so the moments of
 // every scale come from one pass with prefix sums; the eigen solves of all scales run as two
 // batches (vectorised across matrices).
-void point_features(const geometry::Neighbourhood& nb, const std::vector<int>& scales,
+void point_features(const geometry::Neighbourhood& nb, const FeatureParams& params,
                     Scratch& scratch, float* row) {
+  const std::vector<int>& scales = params.scales;
   const int count = static_cast<int>(scales.size());
+  const int per_scale = params.per_scale();
   std::vector<ScaleState>& states = scratch.states;
   std::vector<geometry::SymmetricMatrix3>& matrices = scratch.matrices;
   std::vector<Vector3d>& eigenvalues = scratch.eigenvalues;
@@ -237,26 +287,28 @@ void point_features(const geometry::Neighbourhood& nb, const std::vector<int>& s
   geometry::eigenvalues_descending(matrices.data(), 2 * count, eigenvalues.data());
 
   for (int s = 0; s < count; ++s) {
-    scale_features(states[s], states[0], eigenvalues[s], eigenvalues[count + s],
-                   row + s * kFeaturesPerScale);
+    float* out = row + s * per_scale;
+    scale_features(states[s], states[0], eigenvalues[s], eigenvalues[count + s], out);
+    if (params.angular_gap)
+      out[kAngularGapFeature] =
+          largest_angular_gap(nb, states[s].k, states[s].normal, states[s].spread, scratch);
   }
 }
 
-using PointKernel = void (*)(const geometry::Neighbourhood&, const std::vector<int>&, Scratch&,
+using PointKernel = void (*)(const geometry::Neighbourhood&, const FeatureParams&, Scratch&,
                              float*);
 
 [[gnu::flatten]] void point_features_baseline(const geometry::Neighbourhood& nb,
-                                              const std::vector<int>& scales, Scratch& scratch,
+                                              const FeatureParams& params, Scratch& scratch,
                                               float* row) {
-  point_features(nb, scales, scratch, row);
+  point_features(nb, params, scratch, row);
 }
 #if defined(__x86_64__)
 // The same code in eight-lane vectors with fused multiply-adds: the moment sums round in
 // another order, so features differ from the baseline's by float rounding.
 [[gnu::target("arch=x86-64-v3"), gnu::flatten]] void point_features_x86_64_v3(
-    const geometry::Neighbourhood& nb, const std::vector<int>& scales, Scratch& scratch,
-    float* row) {
-  point_features(nb, scales, scratch, row);
+    const geometry::Neighbourhood& nb, const FeatureParams& params, Scratch& scratch, float* row) {
+  point_features(nb, params, scratch, row);
 }
 #endif
 
@@ -269,8 +321,8 @@ PointKernel point_kernel() {
 
 }  // namespace
 
-float noise_statistic(const float* row, int scales) {
-  const float* smallest = row + (scales - 1) * kFeaturesPerScale;
+float noise_statistic(const float* row, int scales, int per_scale) {
+  const float* smallest = row + (scales - 1) * per_scale;
   // Rounding can leave a flat subset's smallest eigenvalue slightly negative.
   return std::sqrt(std::max(0.0f, smallest[2] + smallest[5]));
 }
@@ -329,7 +381,7 @@ void compute_rows(const PointCloud& cloud, const FeatureParams& params,
       cloud, search,
       [&](const geometry::Neighbourhood& nb) {
         Scratch& scratch = scratches.local();
-        kernel(nb, params.scales, scratch, row_for(nb.point, scratch));
+        kernel(nb, params, scratch, row_for(nb.point, scratch));
         row_written(scratch);
       },
       [&](std::size_t done) { progress.advance(done); });
@@ -346,6 +398,7 @@ FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& par
   FeatureMatrix features;
   features.points = cloud.size();
   features.scales = static_cast<int>(params.scales.size());
+  features.per_scale = params.per_scale();
   features.values.resize(features.points * features.row_size());
   tbb::enumerable_thread_specific<Scratch> scratches;
   compute_rows(
@@ -358,7 +411,7 @@ void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& pa
                                 std::size_t block_size, const FeatureBlockConsumer& consume) {
   check_cloud(cloud, params);
   if (block_size == 0) throw Error("", "block size", "must be at least 1");
-  const std::size_t row_size = params.scales.size() * kFeaturesPerScale;
+  const std::size_t row_size = params.scales.size() * std::size_t(params.per_scale());
   tbb::enumerable_thread_specific<Scratch> scratches([&] {
     Scratch scratch;
     scratch.block_points.reserve(block_size);

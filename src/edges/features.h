@@ -12,6 +12,10 @@
 //   10   c_perp             centre of this scale minus centre of the largest scale's
 //                           remaining points, along the largest scale's normal      eq. (5.17)
 //   11   c_parallel         ... and in that tangent plane                           eq. (5.18)
+// and, with FeatureParams::angular_gap (our addition, not the thesis's), a thirteenth:
+//   12   angular_gap        the largest empty sector of the other neighbours around the normal
+//                           n, in 64 sectors, as a fraction of the turn: PCL's and Open3D's
+//                           boundary rule (a gap above a quarter turn) as a graded value
 // All lengths are in the normalised frame of eq. (5.4) of the scale they belong to, so the
 // features do not depend on the cloud's unit or density.
 //
@@ -29,24 +33,34 @@
 
 namespace glint::edges {
 
-inline constexpr int kFeaturesPerScale = 12;
+inline constexpr int kThesisFeaturesPerScale = 12;
+inline constexpr int kAngularGapFeature = 12;
+
+// Values per scale: the thesis's twelve, or thirteen with the angular gap.
+inline int features_per_scale(bool angular_gap) {
+  return kThesisFeaturesPerScale + (angular_gap ? 1 : 0);
+}
 
 struct FeatureParams {
   // Neighbourhood sizes, largest first (the largest one is the k0 of eq. 5.17).
   std::vector<int> scales{128, 64, 32, 16};
+  bool angular_gap = false;  // the thirteenth value per scale
+  int per_scale() const { return features_per_scale(angular_gap); }
 };
 
-// Row-major features: value(point, scale, feature) at ((point * scales + scale) * 12 + feature).
+// Row-major features: value(point, scale, feature) at
+// ((point * scales + scale) * per_scale + feature).
 struct FeatureMatrix {
   std::size_t points = 0;
   int scales = 0;
+  int per_scale = kThesisFeaturesPerScale;
   std::vector<float> values;
 
-  std::size_t row_size() const { return static_cast<std::size_t>(scales) * kFeaturesPerScale; }
+  std::size_t row_size() const { return static_cast<std::size_t>(scales) * per_scale; }
   const float* row(std::size_t point) const { return values.data() + point * row_size(); }
   float* row(std::size_t point) { return values.data() + point * row_size(); }
   float at(std::size_t point, int scale, int feature) const {
-    return row(point)[scale * kFeaturesPerScale + feature];
+    return row(point)[scale * per_scale + feature];
   }
 };
 
@@ -57,19 +71,19 @@ FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& par
 
 // The same features handed over in blocks as they are computed, never all stored (a 1M-point
 // cloud's rows are 192 MB): consume(points, rows, count) gets up to block_size point indices
-// and their rows (row-major, scales·12 floats each), from several threads at once; every
+// and their rows (row-major, scales·per_scale floats each), from several threads at once; every
 // point comes in exactly one block. Same checks and errors as compute_features.
 using FeatureBlockConsumer =
     std::function<void(const std::uint32_t* points, const float* rows, std::size_t count)>;
 void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& params,
                                 std::size_t block_size, const FeatureBlockConsumer& consume);
 
-// The noise statistic of one point, from its feature row (`scales` scales): at the smallest
-// scale, sqrt(sigma_upper(3) + sigma_lower(3)), the spread of the two half-neighbourhoods off
-// their own planes in the eq. (5.4) frame. Near 0 on clean surfaces away from edges; it grows
-// with displacement noise relative to the point spacing. The noise gate of edges/model.h
-// counts the points where it is below a threshold.
-float noise_statistic(const float* row, int scales);
+// The noise statistic of one point, from its feature row (`scales` scales of `per_scale`
+// values each): at the smallest scale, sqrt(sigma_upper(3) + sigma_lower(3)), the spread of
+// the two half-neighbourhoods off their own planes in the eq. (5.4) frame. Near 0 on clean surfaces
+// away from edges; it grows with displacement noise relative to the point spacing. The noise gate
+// of edges/model.h counts the points where it is below a threshold.
+float noise_statistic(const float* row, int scales, int per_scale);
 
 // Validates scales (>= 6, strictly decreasing); throws glint::Error naming the problem.
 void check_scales(const std::vector<int>& scales);

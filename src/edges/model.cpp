@@ -87,7 +87,7 @@ std::vector<DenseLayer> make_layers(const ModelConfig& config) {
   };
   // Fusion tree: each level halves the number of vectors until two remain.
   int vectors = static_cast<int>(config.scales.size());
-  int width = kFeaturesPerScale;
+  int width = config.features_per_scale();
   for (int level = 0; vectors > 2; ++level, vectors /= 2, width = config.fusion_width)
     for (int node = 0; node < vectors / 2; ++node)
       add(fmt::format("fusion{}.{}", level, node), 2 * width, config.fusion_width);
@@ -100,7 +100,7 @@ std::vector<DenseLayer> make_layers(const ModelConfig& config) {
 
 Model::Model(ModelConfig model_config) : config(std::move(model_config)) {
   check_config(config);
-  const std::size_t columns = config.scales.size() * kFeaturesPerScale;
+  const std::size_t columns = config.scales.size() * std::size_t(config.features_per_scale());
   input_mean.assign(columns, 0.0f);
   input_std.assign(columns, 1.0f);
   layers = make_layers(config);
@@ -115,7 +115,7 @@ std::size_t Model::parameter_count() const {
 void Model::check() const {
   check_config(config);
   const std::string where = "model";
-  const std::size_t columns = config.scales.size() * kFeaturesPerScale;
+  const std::size_t columns = config.scales.size() * std::size_t(config.features_per_scale());
   if (input_mean.size() != columns || input_std.size() != columns)
     throw Error(where, "input_mean/input_std",
                 fmt::format("expected {} values each, have {} and {}", columns, input_mean.size(),
@@ -140,9 +140,10 @@ void Model::check() const {
   if (gated()) {
     if (low_noise->gated()) throw Error(where, "noise_gate", "the gate's network has a gate");
     if (low_noise->config.classes != config.classes || low_noise->config.scales != config.scales ||
+        low_noise->config.angular_gap != config.angular_gap ||
         low_noise->layers.size() != layers.size())
       throw Error(where, "noise_gate.low_noise",
-                  "the gate's network must have the same classes, scales and layers");
+                  "the gate's network must have the same classes, scales, inputs and layers");
     low_noise->check();
     if (!std::isfinite(noise_threshold) || noise_threshold <= 0.0f)
       throw Error(where, "noise_gate.threshold",
@@ -181,7 +182,8 @@ nlohmann::json network_json(const Model& model) {
 // Reads network_json's keys of `object` (key path `where`) into `model`, whose config is set.
 void read_network(const io::JsonFields& reader, const nlohmann::json& object,
                   const std::string& where, Model& model) {
-  const std::size_t columns = model.config.scales.size() * kFeaturesPerScale;
+  const std::size_t columns =
+      model.config.scales.size() * std::size_t(model.config.features_per_scale());
   model.input_mean = reader.floats(object, "input_mean", columns, where);
   model.input_std = reader.floats(object, "input_std", columns, where);
   for (std::size_t c = 0; c < columns; ++c)
@@ -229,7 +231,7 @@ nlohmann::json Model::to_json() const {
                          {"version", kFormatVersion},
                          {"classes", class_names(config.classes)},
                          {"scales", config.scales},
-                         {"features_per_scale", kFeaturesPerScale},
+                         {"features_per_scale", config.features_per_scale()},
                          {"fusion_width", config.fusion_width},
                          {"hidden", config.hidden},
                          {"hidden_layers", config.hidden_layers},
@@ -256,12 +258,15 @@ Model Model::load(const std::string& path) {
     reader.fail("classes",
                 fmt::format("expected {}", nlohmann::json(class_names(class_count)).dump()));
 
-  if (const int features = reader.integer(root, "features_per_scale");
-      features != kFeaturesPerScale)
+  const int features = reader.integer(root, "features_per_scale");
+  if (features != features_per_scale(false) && features != features_per_scale(true))
     reader.fail("features_per_scale",
-                fmt::format("expected {}, got {}", kFeaturesPerScale, features));
+                fmt::format("expected {} (the thesis's features) or {} (with the angular gap), "
+                            "got {}",
+                            features_per_scale(false), features_per_scale(true), features));
 
   ModelConfig config;
+  config.angular_gap = features == features_per_scale(true);
   config.classes = class_count;
   config.scales = reader.integers(root, "scales");
   config.fusion_width = reader.integer(root, "fusion_width");
@@ -299,6 +304,10 @@ void Model::check_features(const FeatureMatrix& features) const {
     throw Error(
         "features", "scales",
         fmt::format("the model expects {} scales, the features have {}", scales, features.scales));
+  if (features.per_scale != config.features_per_scale())
+    throw Error("features", "per_scale",
+                fmt::format("the model expects {} values per scale, the features have {}",
+                            config.features_per_scale(), features.per_scale));
   if (features.values.size() != features.points * features.row_size())
     throw Error("features", "values",
                 fmt::format("expected {} values for {} points, have {}",
@@ -309,7 +318,7 @@ void Model::check_features(const FeatureMatrix& features) const {
 void Model::predict_rows(const float* rows, std::size_t count, float* probabilities,
                          std::uint8_t* labels, PredictScratch& scratch) const {
   const int scales = static_cast<int>(config.scales.size());
-  const std::size_t columns = static_cast<std::size_t>(scales) * kFeaturesPerScale;
+  const std::size_t columns = static_cast<std::size_t>(scales) * config.features_per_scale();
   const std::size_t classes = static_cast<std::size_t>(config.classes);
   std::size_t widest = columns;
   for (const DenseLayer& layer : layers)
@@ -329,7 +338,7 @@ void Model::predict_rows(const float* rows, std::size_t count, float* probabilit
   // Fusion tree: node j of a level reads vectors 2j and 2j+1 (adjacent rows) and writes
   // vector j of the next level.
   std::size_t layer_index = 0;
-  int width = kFeaturesPerScale;
+  int width = config.features_per_scale();
   for (int vectors = scales; vectors > 2; vectors /= 2, width = config.fusion_width) {
     for (int node = 0; node < vectors / 2; ++node) {
       const DenseLayer& layer = layers[layer_index++];

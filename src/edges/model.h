@@ -2,7 +2,8 @@
 // The BoundED classification network (thesis §5.4.2–5.4.3, Fig. 5.4): its definition, fast
 // plain-C++ inference and its JSON model file. Training (libtorch) lives in edges/train.h.
 //
-// Network, for S scales of F = 12 features each and C classes:
+// Network, for S scales of F features each (12, the thesis's; 13 with the angular gap, see
+// edges/features.h) and C classes:
 //   input standardisation   x' = (x - mean) / std per input column (S*F values, fixed, not trained)
 //   pairwise fusion         binary tree over the scales as in PCEDNet: a node concatenates two
 //                           vectors and maps them through Linear(2w, fusion_width) + LeakyReLU;
@@ -10,7 +11,8 @@
 //   head                    hidden_layers x [Linear(.., hidden) + LeakyReLU + Dropout(p)]
 //                           then Linear(hidden, C) + softmax (dropout is off at inference)
 // With the defaults (S = 4, F = 12, C = 3) this has 2*300 + 400 + 272 + 272 + 51 = 1,595
-// trainable parameters (the thesis's "1.6k"); with C = 2 it has 1,578.
+// trainable parameters (the thesis's "1.6k"); with C = 2 it has 1,578; with F = 13 the first
+// fusion level has 2*24 more (1,643 and 1,626).
 //
 // Classes: index = glint point label: 0 non-edge, 1 sharp edge, 2 boundary (C = 3 only).
 //
@@ -36,6 +38,9 @@ struct ModelConfig {
   int hidden = 16;                           // width of each hidden head layer
   int hidden_layers = 3;                     // number of hidden head layers
   float leaky_slope = 0.01f;                 // LeakyReLU negative slope
+  bool angular_gap = false;                  // inputs: the thesis's 12 per scale, or 13
+  int features_per_scale() const { return edges::features_per_scale(angular_gap); }
+  FeatureParams feature_params() const { return FeatureParams{scales, angular_gap}; }
 };
 
 // Throws glint::Error when a config cannot describe a network: classes not 2 or 3, scale

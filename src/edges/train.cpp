@@ -21,7 +21,8 @@ namespace {
 class BoundedNetImpl : public torch::nn::Module {
  public:
   BoundedNetImpl(const ModelConfig& config, double dropout) : config_(config) {
-    const auto columns = static_cast<std::int64_t>(config.scales.size() * kFeaturesPerScale);
+    const auto columns =
+        static_cast<std::int64_t>(config.scales.size()) * config.features_per_scale();
     input_mean_ = register_buffer("input_mean", torch::zeros({columns}));
     input_std_ = register_buffer("input_std", torch::ones({columns}));
     const std::vector<DenseLayer> shapes = make_layers(config);
@@ -37,7 +38,7 @@ class BoundedNetImpl : public torch::nn::Module {
     x = (x - input_mean_) / input_std_;
     // Fusion tree: node j of a level reads vectors 2j and 2j+1 (adjacent columns).
     std::size_t layer = 0;
-    std::int64_t width = kFeaturesPerScale;
+    std::int64_t width = config_.features_per_scale();
     for (int vectors = static_cast<int>(config_.scales.size()); vectors > 2;
          vectors /= 2, width = config_.fusion_width) {
       std::vector<torch::Tensor> fused;

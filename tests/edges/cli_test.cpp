@@ -56,12 +56,25 @@ TEST_F(CliTest, SynthTrainClassifyEval) {
   EXPECT_EQ(scores["predictions"]["tp"], scores["glint:model"]["tp"]);
   EXPECT_EQ(scores["predictions"]["fp"], scores["glint:model"]["fp"]);
 
-  const CommandResult eval = glint("edges eval " + path("clouds") + " --model " +
-                                   path("model.json") + " --report " + path("eval.json"));
+  // A model with the angular gap: 13 inputs per scale, 2 x 2 x 12 more weights in the first
+  // fusion level; eval scores it beside the first, each on its own features.
+  const CommandResult gap_train =
+      glint("edges train " + path("clouds") + " --iterations 30 --batch 1024 --seed 3 " +
+            "--angular-gap -o " + path("gap.json"));
+  ASSERT_EQ(gap_train.exit_code, 0) << gap_train.output;
+  const auto gap_model = nlohmann::json::parse(std::ifstream(path("gap.json")));
+  EXPECT_EQ(gap_model["parameter_count"], 1595 + 48);
+  EXPECT_EQ(gap_model["features_per_scale"], 13);
+
+  const CommandResult eval =
+      glint("edges eval " + path("clouds") + " --model " + path("model.json") + " --model " +
+            path("gap.json") + " --report " + path("eval.json"));
   ASSERT_EQ(eval.exit_code, 0) << eval.output;
   EXPECT_NE(eval.output.find("median"), std::string::npos) << eval.output;
   const auto report = nlohmann::json::parse(std::ifstream(path("eval.json")));
   EXPECT_EQ(report["files"].size(), 4u);
+  EXPECT_TRUE(report["files"][0]["scores"].contains("glint:gap"));
+  EXPECT_TRUE(report["files"][0]["scores"].contains("glint:model"));
 }
 
 TEST_F(CliTest, AngleGapBaselineInEvalAndClassify) {

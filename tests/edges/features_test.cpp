@@ -79,6 +79,31 @@ TEST(Features, HalfPlaneEdgeHasLargeTangentialOffset) {
   }
 }
 
+// A half plane's border point has neighbours on one side only: an empty half turn (less one
+// sector at most, for the nearest neighbours' spread); an interior point's largest gap is a
+// few sectors at the large scales. The thesis's twelve values stay as they are.
+TEST(Features, AngularGapIsHalfATurnOnABorder) {
+  std::mt19937 rng(2);
+  PointCloud plane;
+  add_patch(plane, 30, 60, h, rng, [](float u, float v) { return Eigen::Vector3f(u, v, 0.f); });
+  FeatureParams params;
+  params.angular_gap = true;
+  const FeatureMatrix f = compute_features(plane, params);
+  const FeatureMatrix thesis = compute_features(plane);
+  ASSERT_EQ(f.per_scale, 13);
+  ASSERT_EQ(thesis.per_scale, 12);
+  const std::size_t edge = nearest_to(plane, {0.f, 0.3f, 0.f});
+  const std::size_t interior = nearest_to(plane, {0.15f, 0.3f, 0.f});
+  for (int s = 0; s < 4; ++s) {
+    EXPECT_GE(f.at(edge, s, kAngularGapFeature), 0.4f) << "scale " << s;
+    EXPECT_LE(f.at(edge, s, kAngularGapFeature), 0.6f) << "scale " << s;
+    for (int v = 0; v < kThesisFeaturesPerScale; ++v)
+      EXPECT_EQ(f.at(edge, s, v), thesis.at(edge, s, v)) << "scale " << s << " value " << v;
+  }
+  EXPECT_LE(f.at(interior, 0, kAngularGapFeature), 0.1f);  // k = 128
+  EXPECT_LE(f.at(interior, 3, kAngularGapFeature), 0.3f);  // k = 16: ~15 neighbours
+}
+
 TEST(Features, RightAngleCreaseSeparatesUpperAndLower) {
   std::mt19937 rng(3);
   PointCloud crease;  // an L: floor z = 0 (y >= 0) and wall y = 0 (z >= 0), crease on the x axis

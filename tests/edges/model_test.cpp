@@ -29,10 +29,12 @@ Model random_model(const ModelConfig& config, std::uint64_t seed) {
   return model;
 }
 
-FeatureMatrix random_features(std::size_t points, int scales, std::uint64_t seed) {
+FeatureMatrix random_features(std::size_t points, int scales, std::uint64_t seed,
+                              int per_scale = kThesisFeaturesPerScale) {
   FeatureMatrix features;
   features.points = points;
   features.scales = scales;
+  features.per_scale = per_scale;
   features.values.resize(points * features.row_size());
   std::mt19937_64 rng(seed);
   std::normal_distribution<float> value(0.0f, 1.5f);
@@ -54,9 +56,10 @@ std::vector<double> reference_forward(const Model& model, const float* row) {
   };
   std::vector<std::vector<double>> vectors;
   for (std::size_t s = 0; s < config.scales.size(); ++s) {
-    std::vector<double> v(kFeaturesPerScale);
-    for (int f = 0; f < kFeaturesPerScale; ++f) {
-      const std::size_t c = s * kFeaturesPerScale + f;
+    const int per_scale = config.features_per_scale();
+    std::vector<double> v(per_scale);
+    for (int f = 0; f < per_scale; ++f) {
+      const std::size_t c = s * per_scale + f;
       v[f] = (double(row[c]) - model.input_mean[c]) / model.input_std[c];
     }
     vectors.push_back(v);
@@ -102,6 +105,10 @@ TEST(ModelTest, ParameterCountMatchesTheThesis) {
   ModelConfig two_classes;
   two_classes.classes = 2;
   EXPECT_EQ(Model(two_classes).parameter_count(), 1595u - 17u);
+  // The angular gap: 2 x 26 inputs in the first fusion level, 12 outputs each.
+  ModelConfig angular_gap;
+  angular_gap.angular_gap = true;
+  EXPECT_EQ(Model(angular_gap).parameter_count(), 1595u + 2u * 2u * 12u);
 }
 
 TEST(ModelTest, LayersFollowTheFusionTree) {
@@ -180,13 +187,16 @@ TEST(ModelTest, ZeroWeightsGiveTheSoftmaxOfTheOutputBias) {
 TEST(ModelTest, PredictMatchesAPlainReferenceAcrossBatches) {
   for (const auto& scales : {std::vector<int>{128, 64, 32, 16}, std::vector<int>{128, 32},
                              std::vector<int>{128, 91, 64, 45, 32, 23, 16, 11}}) {
-    for (int classes : {3, 2}) {
+    for (const auto& [classes, angular_gap] :
+         {std::pair{3, false}, std::pair{2, false}, std::pair{3, true}}) {
       ModelConfig config;
       config.scales = scales;
       config.classes = classes;
+      config.angular_gap = angular_gap;
       config.leaky_slope = 0.1f;
       const Model model = random_model(config, 7);
-      const FeatureMatrix features = random_features(1000, int(scales.size()), 3);  // 4 batches
+      const FeatureMatrix features =  // 4 batches
+          random_features(1000, int(scales.size()), 3, config.features_per_scale());
       std::vector<float> probabilities;
       std::vector<std::uint8_t> labels;
       model.predict(features, probabilities, labels);
@@ -213,23 +223,31 @@ TEST(ModelTest, PredictHandlesNoPointsAndRejectsOtherScaleCounts) {
   FeatureMatrix short_values = random_features(3, 4, 1);
   short_values.values.pop_back();
   EXPECT_THROW(model.predict(short_values, probabilities, labels), Error);
+  // Features with the angular gap for a model of the thesis's twelve inputs.
+  EXPECT_THROW(
+      model.predict(random_features(3, 4, 1, kThesisFeaturesPerScale + 1), probabilities, labels),
+      Error);
 }
 
 TEST(ModelTest, SaveLoadRoundTripIsExact) {
   TempDir dir;
-  for (int classes : {3, 2}) {
+  for (const auto& [classes, angular_gap] :
+       {std::pair{3, false}, std::pair{2, false}, std::pair{3, true}}) {
     ModelConfig config;
     config.classes = classes;
+    config.angular_gap = angular_gap;
     Model model = random_model(config, 11 + classes);
     model.input_std[5] = Model::kMinInputStd;
     model.layers[0].weights[0] = 1e-30f;           // tiny and
     model.layers[1].weights[3] = -3.40282347e38f;  // huge floats survive too
     model.training_info = {{"command", "glint edges train a.ply -o m.json"}, {"seed", 5}};
-    const std::string path = dir.file("model" + std::to_string(classes) + ".json");
+    const std::string path =
+        dir.file("model" + std::to_string(classes) + (angular_gap ? "gap" : "") + ".json");
     model.save(path);
 
     const Model loaded = Model::load(path);
     EXPECT_EQ(loaded.config.classes, classes);
+    EXPECT_EQ(loaded.config.angular_gap, angular_gap);
     EXPECT_EQ(loaded.config.scales, config.scales);
     EXPECT_EQ(loaded.config.fusion_width, config.fusion_width);
     EXPECT_EQ(loaded.config.hidden, config.hidden);
@@ -283,6 +301,9 @@ TEST_F(MalformedModelTest, WrongSizesAndShapes) {
   expect_rejected([](nlohmann::json& j) { j["layers"].erase(4); }, "layers");
   expect_rejected([](nlohmann::json& j) { j["layers"][0]["inputs"] = 12; }, "layers[0]");
   expect_rejected([](nlohmann::json& j) { j["scales"] = {128, 64, 32}; }, "scales");
+  expect_rejected([](nlohmann::json& j) { j["features_per_scale"] = 14; }, "features_per_scale");
+  // 13 inputs per scale, but input arrays and layers sized for 12.
+  expect_rejected([](nlohmann::json& j) { j["features_per_scale"] = 13; }, "input_mean");
   expect_rejected([](nlohmann::json& j) { j["parameter_count"] = 1600; }, "parameter_count");
 }
 

@@ -40,7 +40,7 @@ std::vector<float> statistics(const PointCloud& cloud) {
   const FeatureMatrix features = compute_features(cloud);
   std::vector<float> values(features.points);
   for (std::size_t i = 0; i < features.points; ++i)
-    values[i] = noise_statistic(features.row(i), features.scales);
+    values[i] = noise_statistic(features.row(i), features.scales, features.per_scale);
   return values;
 }
 

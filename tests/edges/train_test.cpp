@@ -29,7 +29,7 @@ FeatureMatrix random_features(std::size_t points, int scales, std::uint64_t seed
 // sharp where x > 0.3, else boundary where y > 0.3, else non-edge (|x|, |y| >= 0.3 everywhere).
 TrainingSet separable_problem(std::size_t points, std::uint64_t seed) {
   TrainingSet set{random_features(points, 4, seed), std::vector<std::uint8_t>(points)};
-  const int x_column = 0 * kFeaturesPerScale + 6, y_column = 3 * kFeaturesPerScale + 9;
+  const int x_column = 0 * kThesisFeaturesPerScale + 6, y_column = 3 * kThesisFeaturesPerScale + 9;
   for (std::size_t i = 0; i < points; ++i) {
     float* row = set.features.row(i);
     for (int column : {x_column, y_column}) row[column] += row[column] >= 0 ? 0.3f : -0.3f;
