@@ -173,6 +173,7 @@ float largest_angular_gap(const geometry::Neighbourhood& nb, int k, const Vector
   const Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
   const float ux = float(u.x()), uy = float(u.y()), uz = float(u.z());
   const float vx = float(v.x()), vy = float(v.y()), vz = float(v.z());
+  // A neighbour on the normal through the point (the point itself, duplicates) has no direction.
   const float tiny = float(1e-6 * spread) * float(1e-6 * spread);
   scratch.sector_of.resize(std::size_t(k));
   std::int32_t* sector_of = scratch.sector_of.data();
@@ -188,6 +189,7 @@ float largest_angular_gap(const geometry::Neighbourhood& nb, int k, const Vector
                                                   float(kSectors / (2 * 3.14159265358979))));
     sector_of[j] = a * a + b * b > tiny ? sector : kNoSector;
   }
+  // One bit per occupied sector; kNoSector sets none.
   std::uint64_t occupied = 0;
   for (int j = 0; j < k; ++j)
     occupied |= std::uint64_t(sector_of[j] != kNoSector) << (sector_of[j] & (kSectors - 1));
