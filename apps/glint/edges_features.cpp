@@ -23,7 +23,7 @@ struct FeaturesOptions {
   bool angular_gap = false;
 };
 
-constexpr std::array<const char*, edges::kThesisFeaturesPerScale + 1> kFeatureNames = {
+constexpr std::array<const char*, edges::kAngularGapFeature + 1> kFeatureNames = {
     "sigma_upper1", "sigma_upper2", "sigma_upper3", "sigma_lower1", "sigma_lower2",
     "sigma_lower3", "d_perp",       "d_parallel",   "s_perp",       "s_parallel",
     "c_perp",       "c_parallel",   "angular_gap"};

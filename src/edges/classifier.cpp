@@ -48,7 +48,8 @@ std::vector<Classification> run_networks(const PointCloud& cloud,
   params.scales = scales;
   params.angular_gap = networks.front()->config.angular_gap;
   const int scale_count = static_cast<int>(scales.size());
-  const std::size_t row_size = std::size_t(scale_count) * std::size_t(params.per_scale());
+  const int per_scale = params.per_scale();
+  const std::size_t row_size = std::size_t(scale_count) * std::size_t(per_scale);
   const std::size_t classes = static_cast<std::size_t>(networks.front()->config.classes);
   std::vector<Classification> results;
   for (std::size_t n = 0; n < networks.size(); ++n) results.push_back(sized_result(cloud.size()));
@@ -85,7 +86,7 @@ std::vector<Classification> run_networks(const PointCloud& cloud,
         if (quiet)
           for (std::size_t b = 0; b < count; ++b)
             (*quiet)[points[b]] =
-                noise_statistic(rows + b * row_size, scale_count, params.per_scale()) < threshold;
+                noise_statistic(rows + b * row_size, scale_count, per_scale) < threshold;
         worker.network_s += network_watch.elapsed_s();
       });
   const double total_s = watch.elapsed_s();
