@@ -374,14 +374,14 @@ Keyword options (the CLI's names, '_' for '-', and its defaults):
     model=None (the shipped hemicnn.json), gt_poses=False (True: every frame's pose is used
     instead of tracking), exposure=1 (radiance = pixel / exposure), obs_voxel=0.02,
     obs_voxels, obs_spacing=1, obs_spacing_frames=2, voxel=0.005, trunc=0.02,
-    trunc_per_depth=0.01, depth_max=4, blocks=262144, far_every, far_voxel_pixels,
+    trunc_per_depth=0.005, depth_max=6, blocks=262144, far_every, far_voxel_pixels,
     track_model_halvings, device='auto', segment_noise=0.5, albedo_every=4,
     albedo_average='median', albedo_keep_clipped=False, albedo_min_cosine=0.2,
     albedo_max_ratio=3, albedo_max_indirect=0.5, albedo_shrinkage=True, albedo_smoothing=0.2,
     shadows=True, shadow_test=True, shadow_test_sigmas=2, indirect=True, indirect_scale=True,
     indirect_specular='mirror', unseen_light=False, indirect_rays=64, indirect_rays_per_frame=2,
-    indirect_pooling=True, ray_offset=0.01, specular='hemicnn' ('hemicnn+fit'),
-    normals='gradient' ('plane'), seed=1, render_normal_radius=0.02.
+    indirect_pooling=True, ray_offset=0.01, specular='hemicnn+fit' ('hemicnn'),
+    normals='plane' ('gradient'), seed=1, render_normal_radius=0.02.
 
 Calls on one object are serialised (a lock); the GIL is released while each runs, so other
 Python threads (another Reconstruction, I/O) go on meanwhile.
