@@ -261,6 +261,13 @@ class LightTransport {
   // The scene scale of the gathered light (LightTransportParams::indirect_scaled; 1 without the
   // gather or the scale).
   float indirect_scale() const { return scales_gather() ? scale_ : 1.0f; }
+  // Whether the scene scale sits at indirect_scale_max: where no light reaches, surfaces are at
+  // least that many times as bright as the gathered light explains, which in a room of real
+  // light means a source the lights leave out (a lamp, a window) more often than bounced light
+  // from surfaces never seen.
+  bool indirect_scale_capped() const {
+    return scales_gather() && scale_ >= params_.indirect_scale_max;
+  }
   // Whether the gathered light is scaled: the gather on, scaled, and not the true scene's.
   bool scales_gather() const {
     return params_.indirect && params_.indirect_scaled && !true_indirect_;

@@ -418,15 +418,20 @@ TEST(LightTransport, TheSceneScaleMultipliesTheGatheredLightOnceItHasEnoughSampl
   const std::vector<float> black(LightTransport::kIndirectScaleSamples, 0.0f);
   transport.add_indirect_scale_samples(black);
   EXPECT_TRUE(transport.lighting(v).indirect.isZero());
+  EXPECT_FALSE(transport.indirect_scale_capped());
   const std::vector<float> bright(LightTransport::kIndirectScaleSamples / 2 + 1, 9.0f);
   transport.add_indirect_scale_samples(bright);
   EXPECT_FLOAT_EQ(transport.indirect_scale(), params.indirect_scale_max);
+  EXPECT_TRUE(transport.indirect_scale_capped());  // `glint reconstruct` warns of it
   // Unscaled: the gather as it is, whatever the samples.
   params.indirect_scaled = false;
   params.indirect_specular = IndirectSpecular::off;
   LightTransport unscaled = scene.gather(params);
   unscaled.add_indirect_scale_samples(black);
   EXPECT_FLOAT_EQ(unscaled.indirect_scale(), 1.0f);
+  unscaled.add_indirect_scale_samples(bright);
+  EXPECT_FLOAT_EQ(unscaled.indirect_scale(), 1.0f);
+  EXPECT_FALSE(unscaled.indirect_scale_capped());
   EXPECT_TRUE(unscaled.lighting(v).indirect.isApprox(gathered));
   EXPECT_TRUE(unscaled.lighting(v).indirect_radiance.isZero());  // the lobe mirrors none of it
   // Mirrored by the specular lobe as well: as an even sky of radiance E / pi.
