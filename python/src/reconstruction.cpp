@@ -449,11 +449,14 @@ empty or a previous reconstruction. (The CLI's per-frame pictures and report are
       .def_property_readonly("model", &Reconstruction::model_path, "The HemiCNN model file used.")
       .def("timings", &Reconstruction::timings,
            "Median milliseconds per frame of each stage run so far (geometry, observations,\n"
-           "segmentation, shadows, indirect, specular, albedo, total), as the CLI's report.")
+           "segmentation, shadows, indirect, specular, mirror, albedo, total), as the CLI's\n"
+           "report.")
       .def_property_readonly(
           "indirect_scale", &Reconstruction::indirect_scale,
           "The scale of the gathered indirect light (indirect_scale=True): what the voxels no\n"
-          "light reaches directly show, 0 where they are black; 1 when not scaled.");
+          "light reaches directly show, 0 where they are black; 1 when not scaled. At its cap,\n"
+          "2, they are at least twice as bright as the gathered light explains: a light may be\n"
+          "missing from `lights` (`glint reconstruct` warns of it).");
 }
 
 }  // namespace glint::python
