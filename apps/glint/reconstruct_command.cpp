@@ -269,9 +269,9 @@ void run_reconstruct(ReconstructOptions options) {
   if (pipeline.light_transport().indirect_scale_capped())
     log().warn(
         "the gathered indirect light's scale ended at its cap of {:g}: where no light of --lights "
-        "reaches, the surfaces are at least that many times as bright as the gathered light "
-        "explains. A light missing from --lights (a lamp, a window) would do it, and leaves the "
-        "albedo too bright where that light falls; --indirect-scale off keeps the gather "
+        "reaches, the surfaces are typically at least that many times as bright as the gathered "
+        "light explains. A light missing from --lights (a lamp, a window) would do it, and leaves "
+        "the albedo too bright where that light falls; --indirect-scale off keeps the gather "
         "unscaled",
         options.params.light_transport.indirect_scale_max);
   if (options.report.empty()) return;

@@ -261,9 +261,9 @@ class LightTransport {
   // The scene scale of the gathered light (LightTransportParams::indirect_scaled; 1 without the
   // gather or the scale).
   float indirect_scale() const { return scales_gather() ? scale_ : 1.0f; }
-  // Whether the scene scale sits at indirect_scale_max: where no light reaches, surfaces are at
-  // least that many times as bright as the gathered light explains, which in a room of real
-  // light means a source the lights leave out (a lamp, a window) more often than bounced light
+  // Whether the scene scale sits at indirect_scale_max: where no light reaches, surfaces are
+  // typically at least that many times as bright as the gathered light explains. With real
+  // input that can mean a source the lights leave out (a lamp, a window), or much light bounced
   // from surfaces never seen.
   bool indirect_scale_capped() const {
     return scales_gather() && scale_ >= params_.indirect_scale_max;
