@@ -49,7 +49,7 @@ std::vector<Classification> run_networks(const PointCloud& cloud,
   params.angular_gap = networks.front()->config.angular_gap;
   const int scale_count = static_cast<int>(scales.size());
   const int per_scale = params.per_scale();
-  const std::size_t row_size = std::size_t(scale_count) * std::size_t(per_scale);
+  const std::size_t row_size = params.row_size();
   const std::size_t classes = static_cast<std::size_t>(networks.front()->config.classes);
   std::vector<Classification> results;
   for (std::size_t n = 0; n < networks.size(); ++n) results.push_back(sized_result(cloud.size()));

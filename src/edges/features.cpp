@@ -414,7 +414,7 @@ void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& pa
                                 std::size_t block_size, const FeatureBlockConsumer& consume) {
   check_cloud(cloud, params);
   if (block_size == 0) throw Error("", "block size", "must be at least 1");
-  const std::size_t row_size = params.scales.size() * std::size_t(params.per_scale());
+  const std::size_t row_size = params.row_size();
   tbb::enumerable_thread_specific<Scratch> scratches([&] {
     Scratch scratch;
     scratch.block_points.reserve(block_size);

@@ -46,6 +46,7 @@ struct FeatureParams {
   std::vector<int> scales{128, 64, 32, 16};
   bool angular_gap = false;  // the thirteenth value per scale
   int per_scale() const { return features_per_scale(angular_gap); }
+  std::size_t row_size() const { return scales.size() * std::size_t(per_scale()); }
 };
 
 // Row-major features: value(point, scale, feature) at

@@ -100,7 +100,7 @@ std::vector<DenseLayer> make_layers(const ModelConfig& config) {
 
 Model::Model(ModelConfig model_config) : config(std::move(model_config)) {
   check_config(config);
-  const std::size_t columns = config.scales.size() * std::size_t(config.features_per_scale());
+  const std::size_t columns = config.input_columns();
   input_mean.assign(columns, 0.0f);
   input_std.assign(columns, 1.0f);
   layers = make_layers(config);
@@ -115,7 +115,7 @@ std::size_t Model::parameter_count() const {
 void Model::check() const {
   check_config(config);
   const std::string where = "model";
-  const std::size_t columns = config.scales.size() * std::size_t(config.features_per_scale());
+  const std::size_t columns = config.input_columns();
   if (input_mean.size() != columns || input_std.size() != columns)
     throw Error(where, "input_mean/input_std",
                 fmt::format("expected {} values each, have {} and {}", columns, input_mean.size(),
@@ -182,8 +182,7 @@ nlohmann::json network_json(const Model& model) {
 // Reads network_json's keys of `object` (key path `where`) into `model`, whose config is set.
 void read_network(const io::JsonFields& reader, const nlohmann::json& object,
                   const std::string& where, Model& model) {
-  const std::size_t columns =
-      model.config.scales.size() * std::size_t(model.config.features_per_scale());
+  const std::size_t columns = model.config.input_columns();
   model.input_mean = reader.floats(object, "input_mean", columns, where);
   model.input_std = reader.floats(object, "input_std", columns, where);
   for (std::size_t c = 0; c < columns; ++c)
@@ -318,7 +317,7 @@ void Model::check_features(const FeatureMatrix& features) const {
 void Model::predict_rows(const float* rows, std::size_t count, float* probabilities,
                          std::uint8_t* labels, PredictScratch& scratch) const {
   const int scales = static_cast<int>(config.scales.size());
-  const std::size_t columns = static_cast<std::size_t>(scales) * config.features_per_scale();
+  const std::size_t columns = config.input_columns();
   const std::size_t classes = static_cast<std::size_t>(config.classes);
   std::size_t widest = columns;
   for (const DenseLayer& layer : layers)

@@ -40,6 +40,8 @@ struct ModelConfig {
   float leaky_slope = 0.01f;                 // LeakyReLU negative slope
   bool angular_gap = false;                  // inputs: the thesis's 12 per scale, or 13
   int features_per_scale() const { return edges::features_per_scale(angular_gap); }
+  // Input columns of the network: the feature row of one point.
+  std::size_t input_columns() const { return scales.size() * std::size_t(features_per_scale()); }
   FeatureParams feature_params() const { return FeatureParams{scales, angular_gap}; }
 };
 

@@ -21,8 +21,7 @@ namespace {
 class BoundedNetImpl : public torch::nn::Module {
  public:
   BoundedNetImpl(const ModelConfig& config, double dropout) : config_(config) {
-    const auto columns =
-        static_cast<std::int64_t>(config.scales.size()) * config.features_per_scale();
+    const auto columns = static_cast<std::int64_t>(config.input_columns());
     input_mean_ = register_buffer("input_mean", torch::zeros({columns}));
     input_std_ = register_buffer("input_std", torch::ones({columns}));
     const std::vector<DenseLayer> shapes = make_layers(config);
