@@ -491,11 +491,12 @@ void register_reconstruct_command(CLI::App& app) {
       ->check(CLI::Range(0.0f, 1.0f))
       ->capture_default_str();
   add_on_off_option(command, "--albedo-shrinkage", params.albedo_shrinkage,
-                    "With --indirect on: pull each voxel's refined albedo towards its segment's "
-                    "by how much the gathered light's error (its share of the voxel's irradiance "
-                    "times the gather's measured error) exceeds the segment's own spread of "
-                    "albedo where little light is gathered; the colour stays, texture under "
-                    "direct light stays (off = eq. 7 as is)");
+                    "Pull each voxel's refined albedo towards its segment's by how much its "
+                    "error exceeds the segment's own spread of albedo: the error is how its "
+                    "observations scatter (a voxel across two faces, a misfit highlight) and, "
+                    "with --indirect on, the gathered light's (its share of the irradiance "
+                    "times the gather's measured error); the colour stays, texture seen "
+                    "consistently stays (off = eq. 7 as is)");
   command
       ->add_option("--albedo-smoothing", params.albedo_smoothing,
                    "Re-renderings and the mesh smooth the refined albedo between neighbouring "

@@ -5,12 +5,14 @@
 #include <cmath>
 #include <cstdint>
 #include <numeric>
+#include <span>
 #include <utility>
 #if defined(__SSE__)
 #include <immintrin.h>
 #endif
 
 #include "core/error.h"
+#include "core/robust_statistics.h"
 #include "reflectance/light_incidence.h"
 #include "render/ward.h"
 
@@ -212,6 +214,16 @@ std::optional<DiffuseObservation> observe_diffuse(const Observation* observation
     values[j] = Channels{};
     for (int c = 0; c < 3; ++c) values[j][c] = colour[j][c] - ks[c] * specular[j][c];
   }
+  if (used >= kMinScatterObservations) {
+    std::array<float, kMaxObservationsPerVoxel> luminance;
+    for (int j = 0; j < used; ++j)
+      luminance[std::size_t(j)] = (values[j][0] + values[j][1] + values[j][2]) / 3;
+    const std::span<float> sample(luminance.data(), std::size_t(used));
+    const float median = median_in_place(sample);
+    if (median > 0)
+      observed.radiance_error =
+          robust_spread_in_place(sample, median) / (median * std::sqrt(float(used)));
+  }
   if (average == AlbedoAverage::median) {
     observed.radiance = channel_medians(values.data(), used);
   } else {
@@ -231,6 +243,7 @@ std::optional<RefinedAlbedo> solve_albedo(const DiffuseObservation& observed,
   refined.light_tangent = observed.sines / cosines;
   refined.indirect_share = observed.indirect / cosines;
   refined.lower_bound = observed.lower_bound;
+  refined.radiance_error = observed.radiance_error;
   return refined;
 }
 

@@ -49,6 +49,8 @@ struct RefinedAlbedo {
   float indirect_share = 0.0f;
   // Every observation had clipped: kd is a lower bound on the albedo, not an estimate of it.
   bool lower_bound = false;
+  // DiffuseObservation::radiance_error: eq. (7)'s albedo is off by as much, relatively.
+  float radiance_error = 0.0f;
   float light_cosine() const { return 1.0f / std::sqrt(1.0f + light_tangent * light_tangent); }
 };
 
@@ -104,7 +106,13 @@ struct DiffuseObservation {
   // (RefinedAlbedo::light_tangent), and the indirect part.
   float cosines = 0.0f, sines = 0.0f, indirect = 0.0f;
   bool lower_bound = false;  // every observation had clipped
+  // The relative standard error of the combined radiance, from how the observations' diffuse
+  // luminances scatter: 1.4826 MAD / median over sqrt(n), 0 below kMinScatterObservations.
+  // A voxel straddling two faces, a misfit lobe or a wrong normal scatters; eq. (7)'s albedo
+  // inherits the error (shrink_albedo()).
+  float radiance_error = 0.0f;
 };
+inline constexpr int kMinScatterObservations = 3;
 
 // The observations of a voxel under `lighting` (the lights that reach it, its indirect
 // irradiance): those seen from above the surface, at most kMaxObservationsPerVoxel, combined by
@@ -130,11 +138,16 @@ std::optional<RefinedAlbedo> solve_albedo(const DiffuseObservation& observed,
 float indirect_scale_sample(const DiffuseObservation& observed, const Eigen::Vector3f& gathered,
                             float reference);
 
-// Empirical Bayes shrinkage of a voxel's refined albedo towards its segment's where the gathered
-// light's error dominates it: kd * (reference / max kd)^(1 - w), w = spread^2 / (spread^2 +
-// error^2), in the log of the brightness (largest channel), whose error is relative. `error`:
-// the voxel's relative albedo error from the gathered light (its gathered share of the
-// irradiance times the gather's relative error); `spread`: its segment's own spread of log
+// A voxel's relative albedo error, its observations' scatter and the gathered light's error (its
+// share of the irradiance times the gather's relative error `gather_error`), taken as independent.
+inline float albedo_error(const RefinedAlbedo& refined, float gather_error) {
+  return std::hypot(refined.radiance_error, refined.indirect_share * gather_error);
+}
+
+// Empirical Bayes shrinkage of a voxel's refined albedo towards its segment's where its own error
+// dominates it: kd * (reference / max kd)^(1 - w), w = spread^2 / (spread^2 + error^2), in the
+// log of the brightness (largest channel), whose error is relative. `error`: the voxel's
+// relative albedo error (albedo_error()); `spread`: its segment's own spread of log
 // brightness (texture and noise) where that error is small; `reference`: the segment's
 // brightness. The colour is kept. No error, no spread known (NaN) or no reference: kd as it is.
 Eigen::Vector3f shrink_albedo(const Eigen::Vector3f& kd, float reference, float error,

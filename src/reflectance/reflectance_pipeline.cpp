@@ -227,11 +227,10 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
       if (!refined) continue;
       const Eigen::Vector3f kd = refined->kd.cwiseMax(0.0f).cwiseMin(1.0f);
       // The references, the segment sums and the verdict take the albedo before shrinkage.
-      const float albedo_error = refined->indirect_share * gather_error;
+      const float error = shrink ? albedo_error(*refined, gather_error) : 0.0f;
       grid_.refined_kd(v) =
-          known ? shrink_albedo(kd, reference, albedo_error, albedo_spread_[std::size_t(segment)])
-                : kd;
-      if (shrink && known && albedo_error <= kSpreadMaxError && kd.maxCoeff() > 0) {
+          known ? shrink_albedo(kd, reference, error, albedo_spread_[std::size_t(segment)]) : kd;
+      if (shrink && known && error <= kSpreadMaxError && kd.maxCoeff() > 0) {
         spread_segment_[i] = segment;
         spread_sample_[i] = std::log(kd.maxCoeff() / reference);
       }

@@ -85,10 +85,11 @@ struct ReflectanceParams {
   // the albedo's. Such voxels, mostly in shadow, take the albedo of their lit neighbours or
   // segment instead. 1 trusts them all.
   float albedo_max_indirect_share = 0.5f;
-  // Pull a voxel's refined albedo towards its segment's by how much the gathered light's error
-  // exceeds the segment's own spread of albedo (shrink_albedo()): the gather's error
-  // (LightTransport::indirect_error()) puts smooth blotches where it is much of the irradiance,
-  // while texture shows where it is not. No gathered light: no change. false: eq. (7) as is.
+  // Pull a voxel's refined albedo towards its segment's by how much its own error exceeds the
+  // segment's spread of albedo (shrink_albedo(), albedo_error()): how its observations scatter
+  // (a voxel across two faces, a misfit lobe) and the gathered light's error
+  // (LightTransport::indirect_error(), smooth blotches where it is much of the irradiance).
+  // Texture, consistent across the observations, stays. false: eq. (7) as is.
   bool albedo_shrinkage = true;
   // Re-renderings and the mesh smooth the refined albedo between neighbouring voxels that agree
   // to about this relative contrast (interpolate_refined_kd in reflectance/material_maps.h);
@@ -193,9 +194,9 @@ class ReflectancePipeline {
   static constexpr int kMinReferenceVoxels = 16;
   // Updates each segment's spread of log brightness (ReflectanceParams::albedo_shrinkage) for the
   // next frame: 1.4826 MAD of log(largest channel / reference) over this frame's due voxels whose
-  // albedo error from the gathered light is at most kSpreadMaxError, where the segment has at
-  // least kMinReferenceVoxels of them; else it keeps its last one. 5 %: voxels lit mostly
-  // directly, whose spread is the segment's texture and noise (not tuned).
+  // albedo error (albedo_error()) is at most kSpreadMaxError, where the segment has at least
+  // kMinReferenceVoxels of them; else it keeps its last one. 5 %: voxels observed consistently
+  // and lit mostly directly, whose spread is the segment's texture and noise (not tuned).
   void update_albedo_spreads(int segments);
   static constexpr float kSpreadMaxError = 0.05f;
   // Fits each segment's unseen irradiance (reflectance/unseen_light.h) to this frame's due

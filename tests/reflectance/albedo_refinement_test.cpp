@@ -456,6 +456,43 @@ TEST(AlbedoRefinement, AVoxelNoLightReachesSamplesTheGathersShortfall) {
       std::isnan(indirect_scale_sample(observe(radiance, {.lit = 0}), gathered, std::nanf(""))));
 }
 
+TEST(AlbedoRefinement, AnAlbedosErrorIsItsObservationsScatterAndTheGathers) {
+  // Diffuse-only observations (ks 0) of a surface facing +y under one light straight above
+  // (E = 1 at the origin): observation j's albedo is its colour * pi.
+  std::vector<render::PointLight> lights(1);
+  lights[0].position = {0, 1, 0};
+  lights[0].intensity = {1, 1, 1};
+  const auto error_of = [&](const std::vector<float>& albedos) {
+    std::vector<Observation> obs;
+    for (std::size_t k = 0; k < albedos.size(); ++k) {
+      const Eigen::Vector3f direction = Eigen::Vector3f(0.1f * float(k), 1, 0).normalized();
+      obs.emplace_back(Eigen::Vector3f::Constant(albedos[k] / float(M_PI)), direction, int(k));
+    }
+    const auto refined =
+        refine_albedo(obs.data(), int(obs.size()), Eigen::Vector3f::Zero(),
+                      Eigen::Vector3f::UnitY(), lights, Eigen::Vector3f::Zero(), 0.1f);
+    EXPECT_TRUE(refined);
+    return refined ? refined->radiance_error : NAN;
+  };
+  // Median 0.5, absolute deviations 0.1, 0.05, 0, 0.05, 0.1 (median 0.05): the median's relative
+  // standard error 1.4826 * 0.05 / 0.5 / sqrt(5).
+  EXPECT_NEAR(error_of({0.4f, 0.45f, 0.5f, 0.55f, 0.6f}), 1.4826f * 0.1f / std::sqrt(5.0f), 1e-3f);
+  // Observations that agree, and fewer than kMinScatterObservations: no error.
+  EXPECT_EQ(error_of({0.5f, 0.5f, 0.5f, 0.5f}), 0.0f);
+  EXPECT_EQ(error_of({0.4f, 0.6f}), 0.0f);
+  // A minority of outliers (a voxel mostly on one face, a few views of the other) moves it
+  // little; half the views on each face of a crease, much.
+  EXPECT_LT(error_of({0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.1f, 0.1f}), 0.01f);
+  EXPECT_GT(error_of({0.5f, 0.5f, 0.5f, 0.5f, 0.1f, 0.1f, 0.1f, 0.1f}), 0.2f);
+
+  // The scatter's and the gathered light's errors add in quadrature.
+  RefinedAlbedo refined;
+  refined.radiance_error = 0.03f;
+  refined.indirect_share = 0.5f;
+  EXPECT_NEAR(albedo_error(refined, 0.08f), 0.05f, 1e-6f);
+  EXPECT_NEAR(albedo_error(refined, 0.0f), 0.03f, 1e-6f);
+}
+
 TEST(AlbedoRefinement, AnAlbedoShrinksTowardsItsSegmentsByTheGathersErrorOverTheSpread) {
   const Eigen::Vector3f kd(0.6f, 0.3f, 0.15f);  // brightness 0.6
   const float reference = 0.4f;
