@@ -108,8 +108,9 @@ struct DiffuseObservation {
   bool lower_bound = false;  // every observation had clipped
   // The relative standard error of the combined radiance, from how the observations' diffuse
   // luminances scatter: 1.4826 MAD / median over sqrt(n), 0 below kMinScatterObservations.
-  // A voxel straddling two faces, a misfit lobe or a wrong normal scatters; eq. (7)'s albedo
-  // inherits the error (shrink_albedo()).
+  // A voxel straddling two faces or a misfit lobe scatters; a bias every observation shares
+  // (a wrong normal under one light) does not. Eq. (7)'s albedo inherits the error
+  // (shrink_albedo()).
   float radiance_error = 0.0f;
 };
 inline constexpr int kMinScatterObservations = 3;

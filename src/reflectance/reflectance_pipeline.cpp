@@ -175,7 +175,7 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
       occupancy && transport_.params().shadows && transport_.params().shadow_test;
   const bool scale_gather = transport_.scales_gather();
   const bool shrink = params_.albedo_shrinkage;
-  const float gather_error = shrink ? transport_.indirect_error() : 0.0f;
+  const float gather_error = transport_.indirect_error();
   albedo_spread_.resize(std::size_t(segments), NAN);
   spread_segment_.assign(shrink ? albedo_due_.size() : 0, -1);
   spread_sample_.resize(spread_segment_.size());
