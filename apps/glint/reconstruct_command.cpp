@@ -296,6 +296,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"albedo_max_ratio", options.params.albedo_max_ratio},
          {"albedo_max_indirect_share", options.params.albedo_max_indirect_share},
          {"albedo_shrinkage", options.params.albedo_shrinkage},
+         {"albedo_normal_error", options.params.albedo_normal_error},
          {"albedo_smoothing", options.params.albedo_smoothing},
          {"specular", specular_name(options.params.specular)},
          {"normals", normals_name(options.params.observations)},
@@ -493,10 +494,19 @@ void register_reconstruct_command(CLI::App& app) {
   add_on_off_option(command, "--albedo-shrinkage", params.albedo_shrinkage,
                     "Pull each voxel's refined albedo towards its segment's by how much its "
                     "error exceeds the segment's own spread of albedo: the error is how its "
-                    "observations scatter (a voxel across two faces, a misfit highlight) and, "
-                    "with --indirect on, the gathered light's (its share of the irradiance "
-                    "times the gather's measured error); the colour stays, texture seen "
-                    "consistently stays (off = eq. 7 as is)");
+                    "observations scatter (a voxel across two faces, a misfit highlight), its "
+                    "normal's (--albedo-normal-error, grown by grazing light) and, with "
+                    "--indirect on, the gathered light's (its share of the irradiance times the "
+                    "gather's measured error); the colour stays, texture seen consistently "
+                    "stays (off = eq. 7 as is)");
+  command
+      ->add_option("--albedo-normal-error", params.albedo_normal_error,
+                   "With --albedo-shrinkage on: the error of the voxels' normals, radians; eq. 7 "
+                   "turns it into an albedo error of tan(light incidence) times it, so voxels "
+                   "under grazing light take more of their segment's albedo (0 = the normals "
+                   "are exact)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   command
       ->add_option("--albedo-smoothing", params.albedo_smoothing,
                    "Re-renderings and the mesh smooth the refined albedo between neighbouring "

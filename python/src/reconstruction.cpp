@@ -154,6 +154,8 @@ reflectance::ReflectanceParams params_from(const py::dict& options, std::string&
         p.albedo_max_indirect_share = value.cast<float>();
       } else if (name == "albedo_shrinkage") {
         p.albedo_shrinkage = value.cast<bool>();
+      } else if (name == "albedo_normal_error") {
+        p.albedo_normal_error = value.cast<float>();
       } else if (name == "albedo_max_ratio") {
         p.albedo_max_ratio = value.cast<float>();
       } else if (name == "albedo_smoothing") {
@@ -377,7 +379,8 @@ Keyword options (the CLI's names, '_' for '-', and its defaults):
     trunc_per_depth=0.005, depth_max=6, blocks=262144, far_every, far_voxel_pixels,
     track_model_halvings, device='auto', segment_noise=0.5, albedo_every=4,
     albedo_average='median', albedo_keep_clipped=False, albedo_min_cosine=0.2,
-    albedo_max_ratio=3, albedo_max_indirect=0.5, albedo_shrinkage=True, albedo_smoothing=0.2,
+    albedo_max_ratio=3, albedo_max_indirect=0.5, albedo_shrinkage=True, albedo_normal_error=0.05,
+    albedo_smoothing=0.2,
     shadows=True, shadow_test=True, shadow_test_sigmas=2, indirect=True, indirect_scale=True,
     indirect_specular='mirror', unseen_light=False, indirect_rays=64, indirect_rays_per_frame=2,
     indirect_pooling=True, ray_offset=0.01, specular='hemicnn+fit' ('hemicnn'),

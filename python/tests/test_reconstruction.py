@@ -101,6 +101,8 @@ def test_bad_inputs(sequence):
         glint.Reconstruction(seq.intrinsics, lights, indirect_rays=0)
     with pytest.raises(glint.Error, match="albedo_shrinkage: 'yes': wrong type for this option"):
         glint.Reconstruction(seq.intrinsics, lights, albedo_shrinkage="yes")
+    with pytest.raises(glint.Error, match="albedo_normal_error: must be finite and >= 0"):
+        glint.Reconstruction(seq.intrinsics, lights, albedo_normal_error=-1)
     with pytest.raises(glint.Error, match="shadow_test_sigmas: must be finite and >= 0"):
         glint.Reconstruction(seq.intrinsics, lights, shadow_test_sigmas=-1)
     with pytest.raises(glint.Error, match="specular: phong: must be hemicnn or hemicnn\\+fit"):

@@ -139,10 +139,13 @@ std::optional<RefinedAlbedo> solve_albedo(const DiffuseObservation& observed,
 float indirect_scale_sample(const DiffuseObservation& observed, const Eigen::Vector3f& gathered,
                             float reference);
 
-// A voxel's relative albedo error, its observations' scatter and the gathered light's error (its
-// share of the irradiance times the gather's relative error `gather_error`), taken as independent.
-inline float albedo_error(const RefinedAlbedo& refined, float gather_error) {
-  return std::hypot(refined.radiance_error, refined.indirect_share * gather_error);
+// A voxel's relative albedo error, three parts taken as independent: its observations' scatter,
+// the gathered light's error (its share of the irradiance times the gather's relative error
+// `gather_error`), and its normal's, t * `normal_error` (radians; RefinedAlbedo::light_tangent),
+// which every observation shares and so does not scatter.
+inline float albedo_error(const RefinedAlbedo& refined, float gather_error, float normal_error) {
+  return std::hypot(refined.radiance_error, refined.indirect_share * gather_error,
+                    refined.light_tangent * normal_error);
 }
 
 // Empirical Bayes shrinkage of a voxel's refined albedo towards its segment's where its own error

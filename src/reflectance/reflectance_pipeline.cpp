@@ -82,6 +82,8 @@ ReflectancePipeline::ReflectancePipeline(const Intrinsics& intrinsics,
     throw Error("reflectance pipeline", "albedo_max_ratio", "must be 0 (off) or >= 1");
   if (!(params.albedo_max_indirect_share >= 0 && params.albedo_max_indirect_share <= 1))
     throw Error("reflectance pipeline", "albedo_max_indirect_share", "must be in [0, 1]");
+  if (!(params.albedo_normal_error >= 0 && std::isfinite(params.albedo_normal_error)))
+    throw Error("reflectance pipeline", "albedo_normal_error", "must be finite and >= 0");
   if (!(params.albedo_smoothing >= 0 && std::isfinite(params.albedo_smoothing)))
     throw Error("reflectance pipeline", "albedo_smoothing", "must be finite and >= 0");
   if (lights_.empty())
@@ -227,7 +229,8 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
       if (!refined) continue;
       const Eigen::Vector3f kd = refined->kd.cwiseMax(0.0f).cwiseMin(1.0f);
       // The references, the segment sums and the verdict take the albedo before shrinkage.
-      const float error = shrink ? albedo_error(*refined, gather_error) : 0.0f;
+      const float error =
+          shrink ? albedo_error(*refined, gather_error, params_.albedo_normal_error) : 0.0f;
       grid_.refined_kd(v) =
           known ? shrink_albedo(kd, reference, error, albedo_spread_[std::size_t(segment)]) : kd;
       if (shrink && known && error <= kSpreadMaxError && kd.maxCoeff() > 0) {

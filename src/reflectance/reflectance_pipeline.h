@@ -91,6 +91,12 @@ struct ReflectanceParams {
   // (LightTransport::indirect_error(), smooth blotches where it is much of the irradiance).
   // Texture, consistent across the observations, stays. false: eq. (7) as is.
   bool albedo_shrinkage = true;
+  // The shrinkage's third error: the voxel normal's, in radians, which eq. (7) turns into a
+  // relative albedo error of t times it (RefinedAlbedo::light_tangent): under grazing light the
+  // voxel takes more of its segment's brightness. 0.05 (3 degrees) puts the shrinkage's reliable
+  // voxels (albedo error <= kSpreadMaxError) at light of 45 degrees or steeper, t <= 1, where
+  // refined_albedo_weight() stops weighing by the light too (docs/decisions.md).
+  float albedo_normal_error = 0.05f;
   // Re-renderings and the mesh smooth the refined albedo between neighbouring voxels that agree
   // to about this relative contrast (interpolate_refined_kd in reflectance/material_maps.h);
   // 0 interpolates trilinearly only, as the paper. On a uniform surface a voxel's eq. (7) albedo

@@ -456,7 +456,7 @@ TEST(AlbedoRefinement, AVoxelNoLightReachesSamplesTheGathersShortfall) {
       std::isnan(indirect_scale_sample(observe(radiance, {.lit = 0}), gathered, std::nanf(""))));
 }
 
-TEST(AlbedoRefinement, AnAlbedosErrorIsItsObservationsScatterAndTheGathers) {
+TEST(AlbedoRefinement, AnAlbedosErrorIsItsObservationsScatterTheGathersAndItsNormals) {
   // Diffuse-only observations (ks 0) of a surface facing +y under one light straight above
   // (E = 1 at the origin): observation j's albedo is its colour * pi.
   std::vector<render::PointLight> lights(1);
@@ -485,12 +485,23 @@ TEST(AlbedoRefinement, AnAlbedosErrorIsItsObservationsScatterAndTheGathers) {
   EXPECT_LT(error_of({0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.1f, 0.1f}), 0.01f);
   EXPECT_GT(error_of({0.5f, 0.5f, 0.5f, 0.5f, 0.1f, 0.1f, 0.1f, 0.1f}), 0.2f);
 
-  // The scatter's and the gathered light's errors add in quadrature.
+  // The scatter's, the gathered light's and the normal's errors add in quadrature.
   RefinedAlbedo refined;
   refined.radiance_error = 0.03f;
   refined.indirect_share = 0.5f;
-  EXPECT_NEAR(albedo_error(refined, 0.08f), 0.05f, 1e-6f);
-  EXPECT_NEAR(albedo_error(refined, 0.0f), 0.03f, 1e-6f);
+  EXPECT_NEAR(albedo_error(refined, 0.08f, 0.0f), 0.05f, 1e-6f);
+  EXPECT_NEAR(albedo_error(refined, 0.0f, 0.0f), 0.03f, 1e-6f);
+  // Light at 45 degrees (t = 1) leaves a 0.04 rad normal error at 0.04; at cosine 0.2 (t = 4.9)
+  // the same normal is a fifth of the albedo.
+  refined.radiance_error = 0.0f;
+  refined.indirect_share = 0.0f;
+  refined.light_tangent = 1.0f;
+  EXPECT_NEAR(albedo_error(refined, 0.08f, 0.04f), 0.04f, 1e-6f);
+  refined.light_tangent = tangent_of(0.2f);
+  EXPECT_NEAR(albedo_error(refined, 0.08f, 0.04f), 0.04f * std::sqrt(24.0f), 1e-5f);
+  refined.radiance_error = 0.03f;
+  EXPECT_NEAR(albedo_error(refined, 0.0f, 0.04f), std::hypot(0.03f, 0.04f * std::sqrt(24.0f)),
+              1e-5f);
 }
 
 TEST(AlbedoRefinement, AnAlbedoShrinksTowardsItsSegmentsByTheGathersErrorOverTheSpread) {

@@ -61,6 +61,7 @@ TEST_F(ReconstructCli, WritesTheModelMaterialsLightsPicturesAndReport) {
   EXPECT_TRUE(report["parameters"]["indirect_scaled"].get<bool>());
   EXPECT_EQ(report["parameters"]["indirect_specular"].get<std::string>(), "mirror");
   EXPECT_TRUE(report["parameters"]["albedo_shrinkage"].get<bool>());
+  EXPECT_FLOAT_EQ(report["parameters"]["albedo_normal_error"].get<float>(), 0.05f);
   // The cubes rendered with direct light only: the voxels no light reaches are black, so the
   // gathered light is scaled to (nearly) nothing.
   EXPECT_LT(report["indirect_scale"].get<float>(), 0.1f);
