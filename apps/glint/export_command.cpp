@@ -38,7 +38,7 @@ void add_scene_export_options(CLI::App* command, SceneExportOptions& options) {
       ->add_option("--denoise-iterations", options.params.denoise.iterations,
                    "scene.glb, --denoise-albedo: the guided DIP's steps (default: the "
                    "configuration's, 1200 for fast)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   command
       ->add_option("--up", options.up,
                    "scene.glb: the axis of glint's world that points up (+y for glint's "

@@ -505,7 +505,7 @@ void register_reconstruct_command(CLI::App& app) {
                    "turns it into an albedo error of tan(light incidence) times it, so voxels "
                    "under grazing light take more of their segment's albedo (0 = the normals "
                    "are exact)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->capture_default_str();
   command
       ->add_option("--albedo-smoothing", params.albedo_smoothing,

@@ -303,6 +303,13 @@ TEST_F(SceneExportFiles, ExportCommandWritesTheGlbAndReport) {
   EXPECT_NE(bad.exit_code, 0);
   EXPECT_NE(bad.output.find("--up"), std::string::npos) << bad.output;
   EXPECT_FALSE(fs::exists(path("x.glb")));
+  const CommandResult no_steps =
+      glint("export " + folder + " -o " + path("x.glb") + " --denoise-iterations 0");
+  EXPECT_NE(no_steps.exit_code, 0);
+  EXPECT_NE(no_steps.output.find("--denoise-iterations: must be more than 0, got 0"),
+            std::string::npos)
+      << no_steps.output;
+  EXPECT_FALSE(fs::exists(path("x.glb")));
 }
 
 // A 0.8 m square of 2 cm quads with kd 0.5: its left half seen 30 times (kd within 0.005), its

@@ -251,6 +251,17 @@ TEST_F(ReconstructCli, BadInputsFailClearly) {
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("--albedo-max-indirect"), std::string::npos) << result.output;
   result =
+      glint("reconstruct " + path("seq") + " --gt-lights --albedo-normal-error -1 -o " + path("x"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("--albedo-normal-error: must be 0 or more, got -1"),
+            std::string::npos)
+      << result.output;
+  result = glint("reconstruct " + path("seq") + " --gt-lights --albedo-normal-error inf -o " +
+                 path("x"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("albedo_normal_error: must be finite and >= 0"), std::string::npos)
+      << result.output;
+  result =
       glint("reconstruct " + path("seq") + " --gt-lights --shadow-test-sigmas -1 -o " + path("x"));
   EXPECT_NE(result.exit_code, 0);
   EXPECT_NE(result.output.find("--shadow-test-sigmas: must be 0 or more, got -1"),
