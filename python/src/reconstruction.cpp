@@ -380,11 +380,11 @@ Keyword options (the CLI's names, '_' for '-', and its defaults):
     track_model_halvings, device='auto', segment_noise=0.5, albedo_every=4,
     albedo_average='median', albedo_keep_clipped=False, albedo_min_cosine=0.2,
     albedo_max_ratio=3, albedo_max_indirect=0.5, albedo_shrinkage=True, albedo_normal_error=0.05,
-    albedo_smoothing=0.2,
-    shadows=True, shadow_test=True, shadow_test_sigmas=2, indirect=True, indirect_scale=True,
-    indirect_specular='mirror', unseen_light=False, indirect_rays=64, indirect_rays_per_frame=2,
-    indirect_pooling=True, ray_offset=0.01, specular='hemicnn+fit' ('hemicnn'),
-    normals='plane' ('gradient'), seed=1, render_normal_radius=0.02.
+    albedo_smoothing=0.2, shadows=True, shadow_test=True, shadow_test_sigmas=2, indirect=True,
+    indirect_scale=True, indirect_specular='mirror', unseen_light=False, indirect_rays=64,
+    indirect_rays_per_frame=2, indirect_pooling=True, ray_offset=0.01,
+    specular='hemicnn+fit' ('hemicnn'), normals='plane' ('gradient'), seed=1,
+    render_normal_radius=0.02.
 
 Calls on one object are serialised (a lock); the GIL is released while each runs, so other
 Python threads (another Reconstruction, I/O) go on meanwhile.

@@ -87,9 +87,10 @@ struct ReflectanceParams {
   float albedo_max_indirect_share = 0.5f;
   // Pull a voxel's refined albedo towards its segment's by how much its own error exceeds the
   // segment's spread of albedo (shrink_albedo(), albedo_error()): how its observations scatter
-  // (a voxel across two faces, a misfit lobe) and the gathered light's error
-  // (LightTransport::indirect_error(), smooth blotches where it is much of the irradiance).
-  // Texture, consistent across the observations, stays. false: eq. (7) as is.
+  // (a voxel across two faces, a misfit lobe), its normal's error under the light's angle
+  // (albedo_normal_error) and the gathered light's error (LightTransport::indirect_error(),
+  // smooth blotches where it is much of the irradiance). Texture, consistent across the
+  // observations, stays. false: eq. (7) as is.
   bool albedo_shrinkage = true;
   // The shrinkage's third error: the voxel normal's, in radians, which eq. (7) turns into a
   // relative albedo error of t times it (RefinedAlbedo::light_tangent): under grazing light the
@@ -201,8 +202,9 @@ class ReflectancePipeline {
   // Updates each segment's spread of log brightness (ReflectanceParams::albedo_shrinkage) for the
   // next frame: 1.4826 MAD of log(largest channel / reference) over this frame's due voxels whose
   // albedo error (albedo_error()) is at most kSpreadMaxError, where the segment has at least
-  // kMinReferenceVoxels of them; else it keeps its last one. 5 %: voxels observed consistently
-  // and lit mostly directly, whose spread is the segment's texture and noise (not tuned).
+  // kMinReferenceVoxels of them; else it keeps its last one. 5 %: voxels observed consistently,
+  // lit mostly directly and at 45 degrees or steeper, whose spread is the segment's texture and
+  // noise (not tuned).
   void update_albedo_spreads(int segments);
   static constexpr float kSpreadMaxError = 0.05f;
   // Fits each segment's unseen irradiance (reflectance/unseen_light.h) to this frame's due
