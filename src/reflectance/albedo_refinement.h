@@ -109,8 +109,8 @@ struct DiffuseObservation {
   // The relative standard error of the combined radiance, from how the observations' diffuse
   // luminances scatter: 1.4826 MAD / median over sqrt(n), 0 below kMinScatterObservations.
   // A voxel straddling two faces or a misfit lobe scatters; a bias every observation shares
-  // (a wrong normal under one light) does not. Eq. (7)'s albedo inherits the error
-  // (shrink_albedo()).
+  // (a wrong normal under one light) does not, and albedo_error() adds it by the light's angle.
+  // Eq. (7)'s albedo inherits the error (shrink_albedo()).
   float radiance_error = 0.0f;
 };
 inline constexpr int kMinScatterObservations = 3;
