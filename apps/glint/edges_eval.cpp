@@ -1,6 +1,7 @@
 // glint edges eval: thesis §5.5.2 scores of glint models, saved predictions, the
 // covariance-analysis baseline and the angle-gap boundary baseline on labelled clouds, per file
 // with median and mean.
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -85,6 +86,7 @@ void run_eval(EvalOptions options) {
   if (run_angle_gap) methods.push_back("angle-gap");
   std::map<std::string, std::vector<edges::BinaryScores>> per_method;
   nlohmann::json files_json = nlohmann::json::array();
+  std::vector<std::string> without_positives;  // MCC is undefined there (edges/metrics.h)
 
   fmt::print("task: {} (positive = {})\n", options.task,
              task == edges::EvalTask::sharp      ? "sharp edge; boundary counts as negative"
@@ -97,6 +99,9 @@ void run_eval(EvalOptions options) {
     const PointCloud cloud = io::read_point_cloud(path);
     const std::vector<std::uint8_t> truth = labels_of(cloud, path);
     const std::string name = std::filesystem::path(path).filename().string();
+    if (std::none_of(truth.begin(), truth.end(),
+                     [&](std::uint8_t label) { return edges::is_positive(label, task); }))
+      without_positives.push_back(name);
     nlohmann::json file_json = {{"file", path}, {"points", cloud.size()}, {"scores", {}}};
     auto record = [&](const std::string& method, const std::vector<std::uint8_t>& predicted,
                       double seconds) {
@@ -158,6 +163,12 @@ void run_eval(EvalOptions options) {
   for (const auto& method : methods) print_row("median", method, summaries[method].median);
   for (const auto& method : methods) print_row("mean", method, summaries[method].mean);
   for (const auto& method : methods) print_row("all points", method, summaries[method].pooled);
+  if (!without_positives.empty())
+    log().warn(
+        "{} of {} files have no {} point ({}{}): their MCC is undefined and counts as 0 in the "
+        "median and mean, whatever a method predicts; the all-points row pools their counts",
+        without_positives.size(), truth_files.size(), edges::to_string(task),
+        without_positives.front(), without_positives.size() > 1 ? ", ..." : "");
   if (!options.report.empty()) {
     io::write_json(options.report, {{"command", command_line()},
                                     {"task", options.task},
@@ -177,6 +188,7 @@ void run_eval(EvalOptions options) {
                                       {"angle_threshold_rad", options.angle_gap.angle_threshold},
                                       {"enabled", run_angle_gap}}},
                                     {"files", files_json},
+                                    {"files_without_positives", without_positives},
                                     {"summary", summary_json}});
     fmt::print("report -> {}\n", options.report);
   }

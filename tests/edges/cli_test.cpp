@@ -94,11 +94,17 @@ TEST_F(CliTest, AngleGapBaselineInEvalAndClassify) {
   EXPECT_TRUE(report["summary"].contains("angle-gap"));
   EXPECT_GT(report["summary"]["angle-gap"]["median"]["recall"].get<double>(), 0.0);
   EXPECT_EQ(report["angle_gap_baseline"]["radius_spacings"], 1.5);
+  EXPECT_TRUE(report["files_without_positives"].empty());
   const CommandResult sharp =
       glint("edges eval " + sheet + " --pred " + sheet + " --report " + path("sharp.json"));
   ASSERT_EQ(sharp.exit_code, 0) << sharp.output;
-  EXPECT_FALSE(
-      nlohmann::json::parse(std::ifstream(path("sharp.json")))["summary"].contains("angle-gap"));
+  const auto sharp_report = nlohmann::json::parse(std::ifstream(path("sharp.json")));
+  EXPECT_FALSE(sharp_report["summary"].contains("angle-gap"));
+  // A sheet has no sharp edge: its MCC is undefined, and eval says so rather than let the 0 pass
+  // for a score.
+  EXPECT_EQ(sharp_report["files_without_positives"].size(), 1u);
+  EXPECT_NE(sharp.output.find("1 of 1 files have no sharp point"), std::string::npos)
+      << sharp.output;
 
   const CommandResult classify =
       glint("edges classify " + sheet + " -o " + path("gap.ply") + " --method angle-gap");
