@@ -23,15 +23,21 @@ BlockOccupancy::BlockOccupancy(const TsdfVolume& volume) {
   if (size.x() * size.y() * size.z() > kMaxBits) return;  // may_hold() says "maybe" to all
   size_ = size.cast<int>();
   words_.assign((size.x() * size.y() * size.z() + 63) / 64, 0);
-  cells_ = (size_.array() + (kCellSide - 1)) / kCellSide;
-  cell_words_.assign((std::uint64_t(cells_.x()) * cells_.y() * cells_.z() + 63) / 64, 0);
+  levels_.resize(kLevels);
+  for (int level = 1; level <= kLevels; ++level) {
+    CellLevel& cells = levels_[std::size_t(level - 1)];
+    const int side = 1 << level;
+    cells.cells = (size_.array() + (side - 1)) / side;
+    cells.words.assign(
+        (std::uint64_t(cells.cells.x()) * cells.cells.y() * cells.cells.z() + 63) / 64, 0);
+  }
   for (std::size_t i = 0; i < blocks; ++i) {
     const Eigen::Vector3i b = hash.block(int(i)) - low_;
     const std::uint64_t bit =
         (std::uint64_t(b.z()) * size.y() + std::uint64_t(b.y())) * size.x() + std::uint64_t(b.x());
     words_[bit >> 6] |= std::uint64_t{1} << (bit & 63);
-    const std::uint64_t cell = cell_bit(b / kCellSide);
-    cell_words_[cell >> 6] |= std::uint64_t{1} << (cell & 63);
+    for (int level = 1; level <= kLevels; ++level)
+      levels_[std::size_t(level - 1)].mark(b.unaryExpr([level](int v) { return v >> level; }));
   }
 }
 
@@ -52,11 +58,14 @@ void BlockOccupancy::empty_region(int bx, int by, int bz, Eigen::Vector3i& first
     }
     return;
   }
-  const Eigen::Vector3i c = (block - low_) / kCellSide;
-  const std::uint64_t cell = cell_bit(c);
-  if (cell_words_[cell >> 6] >> (cell & 63) & 1) return;
-  first = low_ + c * kCellSide;
-  last = first + Eigen::Vector3i::Constant(kCellSide - 1);
+  // A cell is empty only where the cells inside it are: climb while the next one up is empty.
+  const Eigen::Vector3i offset = block - low_;
+  for (int level = 1; level <= kLevels; ++level) {
+    const Eigen::Vector3i c = offset.unaryExpr([level](int v) { return v >> level; });
+    if (levels_[std::size_t(level - 1)].holds(c)) return;
+    first = low_ + c * (1 << level);
+    last = first + Eigen::Vector3i::Constant((1 << level) - 1);
+  }
 }
 
 }  // namespace glint::fusion

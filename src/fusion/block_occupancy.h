@@ -3,9 +3,10 @@
 // bounding box of the allocated ones. A ray cast crosses far more empty blocks than allocated
 // ones (office: 1.65 M samples per view in unallocated space), and asking the block hash about
 // each missed the caches: the hash table is megabytes of slots, the bit array a few hundred
-// kilobytes. A second, coarser array marks the cells of kCellSide^3 blocks that hold any: a ray
-// crosses an empty cell in one step instead of one per block. A snapshot: blocks allocated
-// afterwards are not in it.
+// kilobytes. Coarser arrays mark the cells of 2^l blocks per side (l = 1 .. kLevels) that hold
+// any: a ray crosses the largest empty cell around it in one step instead of one per block
+// (office at 2 cm: 113 M samples in unallocated space over 40 frames with cells of 4^3 blocks
+// alone, 48 M with the levels). A snapshot: blocks allocated afterwards are not in it.
 #include <Eigen/Core>
 #include <cstdint>
 #include <vector>
@@ -19,8 +20,8 @@ class BlockOccupancy {
   // Bit arrays above this many bits (a bounding box of 2^30 blocks: 43 km^3 of 4 cm blocks) are
   // not built; may_hold() then answers true for every block.
   static constexpr std::uint64_t kMaxBits = std::uint64_t{1} << 30;
-  static constexpr int kCellShift = 2;  // cells of 4^3 blocks (16 cm of 5 mm voxels)
-  static constexpr int kCellSide = 1 << kCellShift;
+  // Cells of 2^3 up to 2^kLevels blocks per side (5.1 m of 5 mm voxels at the top).
+  static constexpr int kLevels = 7;
 
   explicit BlockOccupancy(const TsdfVolume& volume);
 
@@ -38,9 +39,9 @@ class BlockOccupancy {
   }
 
   // The blocks [first, last] (inclusive) around block (bx, by, bz) that surely hold no allocated
-  // one: its cell where the cell holds none, a slab of the space outside the bounding box where
-  // the block lies there (unbounded along the other axes: INT_MIN / INT_MAX), else the block
-  // alone, which must not be allocated. Only the block where no bit array was built.
+  // one: the largest cell holding it that holds none, a slab of the space outside the bounding
+  // box where the block lies there (unbounded along the other axes: INT_MIN / INT_MAX), else the
+  // block alone, which must not be allocated. Only the block where no bit array was built.
   void empty_region(int bx, int by, int bz, Eigen::Vector3i& first, Eigen::Vector3i& last) const;
 
   // The blocks [low, high] (block coordinates, inclusive) that hold every allocated one; false
@@ -53,18 +54,30 @@ class BlockOccupancy {
   }
 
  private:
-  // The bit of cell c (cell coordinates from low_) in cell_words_.
-  std::uint64_t cell_bit(const Eigen::Vector3i& c) const {
-    return (std::uint64_t(c.z()) * std::uint64_t(cells_.y()) + std::uint64_t(c.y())) *
-               std::uint64_t(cells_.x()) +
-           std::uint64_t(c.x());
-  }
+  // The cells of one level: 2^level blocks per side, one bit per cell over the box.
+  struct CellLevel {
+    Eigen::Vector3i cells = Eigen::Vector3i::Zero();  // cells per axis
+    std::vector<std::uint64_t> words;
+
+    std::uint64_t bit(const Eigen::Vector3i& c) const {
+      return (std::uint64_t(c.z()) * std::uint64_t(cells.y()) + std::uint64_t(c.y())) *
+                 std::uint64_t(cells.x()) +
+             std::uint64_t(c.x());
+    }
+    bool holds(const Eigen::Vector3i& c) const {
+      const std::uint64_t b = bit(c);
+      return words[b >> 6] >> (b & 63) & 1;
+    }
+    void mark(const Eigen::Vector3i& c) {
+      const std::uint64_t b = bit(c);
+      words[b >> 6] |= std::uint64_t{1} << (b & 63);
+    }
+  };
 
   Eigen::Vector3i low_ = Eigen::Vector3i::Zero(), size_ = Eigen::Vector3i::Zero();
   std::vector<std::uint64_t> words_;
-  Eigen::Vector3i cells_ = Eigen::Vector3i::Zero();  // cells per axis over the box
-  std::vector<std::uint64_t> cell_words_;            // one bit per cell
-  bool built_empty_ = false;                         // the volume held no block
+  std::vector<CellLevel> levels_;  // levels_[l - 1]: cells of 2^l blocks per side
+  bool built_empty_ = false;       // the volume held no block
 };
 
 }  // namespace glint::fusion

@@ -148,7 +148,17 @@ TEST(BlockOccupancy, EmptyRegionsHoldNoAllocatedBlock) {
   const std::vector<Eigen::Vector3i> allocated = {{-9, 0, 2}, {4, -1, 2}, {0, 5, -6}, {1, 1, 1}};
   for (const Eigen::Vector3i& b : allocated) ASSERT_GE(volume.allocate(b), 0);
   const BlockOccupancy occupancy(volume);
-  int whole_cells = 0, slabs = 0;
+  Eigen::Vector3i low, high;
+  ASSERT_TRUE(occupancy.bounds(low, high));
+  // Whether the cube of `side` blocks aligned on the box's corner that holds `block` holds an
+  // allocated block.
+  const auto cell_holds_one = [&](const Eigen::Vector3i& block, int side) {
+    const Eigen::Vector3i first = low + ((block - low) / side) * side;
+    return std::any_of(allocated.begin(), allocated.end(), [&](const Eigen::Vector3i& b) {
+      return ((first.array() <= b.array()) && (b.array() < first.array() + side)).all();
+    });
+  };
+  int whole_cells = 0, slabs = 0, larger_cells = 0;
   for (int z = -12; z <= 12; ++z)
     for (int y = -12; y <= 12; ++y)
       for (int x = -12; x <= 12; ++x) {
@@ -163,9 +173,19 @@ TEST(BlockOccupancy, EmptyRegionsHoldNoAllocatedBlock) {
               << "the region of " << x << " " << y << " " << z << " holds " << b.transpose();
         const bool unbounded = (first.array() == INT_MIN).any() || (last.array() == INT_MAX).any();
         slabs += unbounded;
-        whole_cells += !unbounded && last != first;
+        if (unbounded) continue;
+        // Inside the box: the largest empty cell of 2^l blocks per side, l >= 0.
+        const int side = last.x() - first.x() + 1;
+        ASSERT_EQ(last - first, Eigen::Vector3i::Constant(side - 1));
+        const Eigen::Vector3i offset = first - low;
+        ASSERT_TRUE(offset.x() % side == 0 && offset.y() % side == 0 && offset.z() % side == 0);
+        ASSERT_TRUE(cell_holds_one(block, 2 * side))
+            << "the region of " << x << " " << y << " " << z << " could be larger than " << side;
+        whole_cells += side > 1;
+        larger_cells += side > 4;
       }
-  EXPECT_GT(whole_cells, 100);  // 4^3-block cells between the blocks
+  EXPECT_GT(whole_cells, 100);  // cells of blocks between the blocks
+  EXPECT_GT(larger_cells, 0);   // cells of 8^3 blocks and more
   EXPECT_GT(slabs, 1000);       // around the box of the blocks
 
   // Without a bit array (an empty volume's), only the block itself.
