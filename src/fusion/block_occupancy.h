@@ -20,7 +20,7 @@ class BlockOccupancy {
   // Bit arrays above this many bits (a bounding box of 2^30 blocks: 43 km^3 of 4 cm blocks) are
   // not built; may_hold() then answers true for every block.
   static constexpr std::uint64_t kMaxBits = std::uint64_t{1} << 30;
-  // Cells of 2^3 up to 2^kLevels blocks per side (5.1 m of 5 mm voxels at the top).
+  // Cells of 2 up to 2^kLevels blocks per side (5.1 m of 5 mm voxels at the top).
   static constexpr int kLevels = 7;
 
   explicit BlockOccupancy(const TsdfVolume& volume);
