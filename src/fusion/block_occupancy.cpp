@@ -22,10 +22,9 @@ BlockOccupancy::BlockOccupancy(const TsdfVolume& volume) {
       Eigen::Matrix<std::uint64_t, 3, 1>::Ones();
   if (size.x() * size.y() * size.z() > kMaxBits) return;  // may_hold() says "maybe" to all
   size_ = size.cast<int>();
-  words_.assign((size.x() * size.y() * size.z() + 63) / 64, 0);
-  levels_.resize(kLevels);
-  for (int level = 1; level <= kLevels; ++level) {
-    CellLevel& cells = levels_[std::size_t(level - 1)];
+  levels_.resize(kLevels + 1);
+  for (int level = 0; level <= kLevels; ++level) {
+    CellLevel& cells = levels_[std::size_t(level)];
     const int side = 1 << level;
     cells.cells = (size_.array() + (side - 1)) / side;
     cells.words.assign(
@@ -33,11 +32,8 @@ BlockOccupancy::BlockOccupancy(const TsdfVolume& volume) {
   }
   for (std::size_t i = 0; i < blocks; ++i) {
     const Eigen::Vector3i b = hash.block(int(i)) - low_;
-    const std::uint64_t bit =
-        (std::uint64_t(b.z()) * size.y() + std::uint64_t(b.y())) * size.x() + std::uint64_t(b.x());
-    words_[bit >> 6] |= std::uint64_t{1} << (bit & 63);
-    for (int level = 1; level <= kLevels; ++level)
-      levels_[std::size_t(level - 1)].mark(b.unaryExpr([level](int v) { return v >> level; }));
+    for (int level = 0; level <= kLevels; ++level)
+      levels_[std::size_t(level)].mark(b.unaryExpr([level](int v) { return v >> level; }));
   }
 }
 
@@ -45,7 +41,7 @@ void BlockOccupancy::empty_region(int bx, int by, int bz, Eigen::Vector3i& first
                                   Eigen::Vector3i& last) const {
   const Eigen::Vector3i block(bx, by, bz);
   first = last = block;
-  if (words_.empty()) return;
+  if (levels_.empty()) return;
   const Eigen::Vector3i high = low_ + size_ - Eigen::Vector3i::Ones();
   for (int axis = 0; axis < 3; ++axis) {
     if (block[axis] >= low_[axis] && block[axis] <= high[axis]) continue;
@@ -62,7 +58,7 @@ void BlockOccupancy::empty_region(int bx, int by, int bz, Eigen::Vector3i& first
   const Eigen::Vector3i offset = block - low_;
   for (int level = 1; level <= kLevels; ++level) {
     const Eigen::Vector3i c = offset.unaryExpr([level](int v) { return v >> level; });
-    if (levels_[std::size_t(level - 1)].holds(c)) return;
+    if (levels_[std::size_t(level)].holds(c)) return;
     first = low_ + c * (1 << level);
     last = first + Eigen::Vector3i::Constant((1 << level) - 1);
   }

@@ -27,15 +27,14 @@ class BlockOccupancy {
 
   // False only where block (bx, by, bz) is surely not allocated.
   bool may_hold(int bx, int by, int bz) const {
-    if (words_.empty()) return !built_empty_;
+    if (levels_.empty()) return !built_empty_;
     const std::uint64_t x = std::uint64_t(std::int64_t(bx) - low_.x());
     const std::uint64_t y = std::uint64_t(std::int64_t(by) - low_.y());
     const std::uint64_t z = std::uint64_t(std::int64_t(bz) - low_.z());
     if (x >= std::uint64_t(size_.x()) || y >= std::uint64_t(size_.y()) ||
         z >= std::uint64_t(size_.z()))
       return false;
-    const std::uint64_t bit = (z * std::uint64_t(size_.y()) + y) * std::uint64_t(size_.x()) + x;
-    return words_[bit >> 6] >> (bit & 63) & 1;
+    return levels_[0].holds(Eigen::Vector3i(int(x), int(y), int(z)));
   }
 
   // The blocks [first, last] (inclusive) around block (bx, by, bz) that surely hold no allocated
@@ -47,14 +46,15 @@ class BlockOccupancy {
   // The blocks [low, high] (block coordinates, inclusive) that hold every allocated one; false
   // where there is none or the bit array was not built (no box is known).
   bool bounds(Eigen::Vector3i& low, Eigen::Vector3i& high) const {
-    if (words_.empty()) return false;
+    if (levels_.empty()) return false;
     low = low_;
     high = low_ + size_ - Eigen::Vector3i::Ones();
     return true;
   }
 
  private:
-  // The cells of one level: 2^level blocks per side, one bit per cell over the box.
+  // The cells of one level: 2^level blocks per side (level 0: the blocks), one bit per cell over
+  // the box.
   struct CellLevel {
     Eigen::Vector3i cells = Eigen::Vector3i::Zero();  // cells per axis
     std::vector<std::uint64_t> words;
@@ -75,8 +75,7 @@ class BlockOccupancy {
   };
 
   Eigen::Vector3i low_ = Eigen::Vector3i::Zero(), size_ = Eigen::Vector3i::Zero();
-  std::vector<std::uint64_t> words_;
-  std::vector<CellLevel> levels_;  // levels_[l - 1]: cells of 2^l blocks per side
+  std::vector<CellLevel> levels_;  // levels_[l]: cells of 2^l blocks per side, l = 0 .. kLevels
   bool built_empty_ = false;       // the volume held no block
 };
 
