@@ -37,6 +37,8 @@ class RayQueue {
   // Where ray `ray` ended once marched: MarchEnd::t > 0 at a + to - crossing, back_face where it
   // entered a surface from behind, neither where it met none.
   const MarchEnd& end(int ray) const { return ends_[std::size_t(ray)]; }
+  // The TSDF's voxel size (metres): how far a crossing may lie from the surface it interpolates.
+  float voxel_m() const { return voxel_m_; }
 
  private:
   float voxel_m_;

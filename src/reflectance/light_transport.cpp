@@ -11,6 +11,7 @@
 #include "fusion/ray_queue.h"
 #include "fusion/tsdf_sampler.h"
 #include "reflectance/hemi_image.h"
+#include "reflectance/hit_radiance.h"
 #include "render/embree_scene.h"
 #include "render/renderer.h"
 #include "render/ward_sampling.h"
@@ -50,31 +51,6 @@ struct WorldBox {
     return known ? std::max(fusion::box_exit(origin, direction, low, high), 0.0f) : INFINITY;
   }
 };
-
-// Under the diffuse assumption the radiance voxel u sends every way: the colour of its
-// observation of median luminance (its highlights, seen from few directions, lie above it).
-bool diffuse_radiance(const ObservationGrid& grid, int u, Eigen::Vector3f& radiance) {
-  const int count = std::min(grid.observation_count(u), kMaxObservationsPerVoxel);
-  if (count == 0) return false;
-  const Observation* observations = grid.observations(u);
-  std::array<std::pair<float, int>, kMaxObservationsPerVoxel> luminance;
-  for (int k = 0; k < count; ++k) luminance[std::size_t(k)] = {observations[k].colour().mean(), k};
-  std::nth_element(luminance.begin(), luminance.begin() + count / 2, luminance.begin() + count);
-  radiance = observations[luminance[std::size_t(count / 2)].second].colour();
-  return true;
-}
-
-// The observed radiance at ray hit h (the ray along unit d): the voxel holding h, or, where that
-// has no observations (h lies on a voxel face), the one half a voxel back along the ray. False
-// where neither has any.
-bool hit_radiance(const ObservationGrid& grid, const Eigen::Vector3f& h, const Eigen::Vector3f& d,
-                  ObservationGrid::BlockCache& blocks, Eigen::Vector3f& radiance) {
-  for (const float back : {0.0f, 0.5f}) {
-    const int u = grid.find(h - d * (back * float(grid.params().voxel_size_m)), &blocks);
-    if (u >= 0 && diffuse_radiance(grid, u, radiance)) return true;
-  }
-  return false;
-}
 
 // Whether h lies on the proxy sphere of one of the lights: its direct light is already counted.
 bool on_light(const std::vector<render::PointLight>& lights, const Eigen::Vector3f& h,
@@ -170,7 +146,8 @@ bool gathered_radiance(const fusion::RayQueue& queue, int ray, const Observation
   if (!(hit.t > 0)) return true;
   const Eigen::Vector3f& direction = queue.direction(ray);
   const Eigen::Vector3f h = queue.origin(ray) + direction * hit.t;
-  if (!on_light(lights, h, margin) && !hit_radiance(grid, h, direction, blocks, radiance))
+  if (!on_light(lights, h, margin) &&
+      !hit_radiance(grid, h, direction, queue.voxel_m(), blocks, radiance))
     return false;
   if (!(radiance.maxCoeff() < saturated_radiance)) radiance = Eigen::Vector3f::Zero();
   return true;
