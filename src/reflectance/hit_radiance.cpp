@@ -18,17 +18,21 @@ bool diffuse_radiance(const ObservationGrid& grid, int u, Eigen::Vector3f& radia
   return true;
 }
 
-bool hit_radiance(const ObservationGrid& grid, const Eigen::Vector3f& h, const Eigen::Vector3f& d,
-                  float tolerance, ObservationGrid::BlockCache& blocks, Eigen::Vector3f& radiance) {
+namespace {
+
+bool observed(const ObservationGrid& grid, int u) {
+  return u >= 0 && grid.observation_count(u) > 0;
+}
+
+// The observed one of the neighbours across the faces of p's voxel within `tolerance` of p,
+// nearest first; -1 where none is.
+int observed_across_faces(const ObservationGrid& grid, const Eigen::Vector3f& p, float tolerance,
+                          ObservationGrid::BlockCache& blocks) {
   const float size = float(grid.params().voxel_size_m);
-  for (const float back : {0.0f, 0.5f}) {
-    const int u = grid.find(h - d * (back * size), &blocks);
-    if (u >= 0 && diffuse_radiance(grid, u, radiance)) return true;
-  }
-  const Eigen::Vector3f v = h / size;
+  const Eigen::Vector3f v = p / size;
   const Eigen::Vector3i voxel(int(std::floor(v.x())), int(std::floor(v.y())),
                               int(std::floor(v.z())));
-  // Per axis the nearer face of h's voxel: its distance and the neighbour across it.
+  // Per axis the nearer face of p's voxel: its distance and the neighbour across it.
   std::array<std::pair<float, Eigen::Vector3i>, 3> faces;
   for (int axis = 0; axis < 3; ++axis) {
     const float below = (v[axis] - float(voxel[axis])) * size, above = size - below;
@@ -40,10 +44,27 @@ bool hit_radiance(const ObservationGrid& grid, const Eigen::Vector3f& h, const E
             [](const auto& a, const auto& b) { return a.first < b.first; });
   for (const auto& [distance, neighbour] : faces) {
     if (!(distance <= tolerance)) break;
-    const int u = grid.find_voxel(neighbour, &blocks);
-    if (u >= 0 && diffuse_radiance(grid, u, radiance)) return true;
+    if (const int u = grid.find_voxel(neighbour, &blocks); observed(grid, u)) return u;
   }
-  return false;
+  return -1;
+}
+
+}  // namespace
+
+int observed_voxel(const ObservationGrid& grid, const Eigen::Vector3f& p, float tolerance,
+                   ObservationGrid::BlockCache& blocks) {
+  if (const int u = grid.find(p, &blocks); observed(grid, u)) return u;
+  return observed_across_faces(grid, p, tolerance, blocks);
+}
+
+bool hit_radiance(const ObservationGrid& grid, const Eigen::Vector3f& h, const Eigen::Vector3f& d,
+                  float tolerance, ObservationGrid::BlockCache& blocks, Eigen::Vector3f& radiance) {
+  const float size = float(grid.params().voxel_size_m);
+  for (const float back : {0.0f, 0.5f})
+    if (const int u = grid.find(h - d * (back * size), &blocks); observed(grid, u))
+      return diffuse_radiance(grid, u, radiance);
+  const int u = observed_across_faces(grid, h, tolerance, blocks);
+  return u >= 0 && diffuse_radiance(grid, u, radiance);
 }
 
 }  // namespace glint::reflectance

@@ -604,10 +604,12 @@ PointLighting PointLightingQuery::operator()(const Eigen::Vector3f& p, const Eig
                      ? true_shadow_mask(*transport_.true_scene(), volume_, lights_, p, n,
                                         params.ray_offset_m)
                      : shadow_mask(rays_, volume_, lights_, p, n, params.ray_offset_m);
-  // The voxel under the pixel holds its indirect light and the lights the shadow test dropped.
+  // The voxel holding the pixel's surface holds its indirect light and the lights the shadow
+  // test dropped.
   const bool indirect = params.indirect || params.unseen;
   if (indirect || (params.shadows && params.shadow_test))
-    if (const int v = grid_.find(p, &blocks_); v >= 0) {
+    if (const int v = observed_voxel(grid_, p, float(volume_.params().voxel_size_m), blocks_);
+        v >= 0) {
       result.lit &= ~transport_.occluded(v);
       if (indirect) {
         const PointLighting voxel = transport_.lighting(v, grid_.segment(v));

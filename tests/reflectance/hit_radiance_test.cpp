@@ -1,6 +1,7 @@
 // The radiance a ray brings back from the surface it hit (reflectance/hit_radiance.h): a wall
 // 1 mm in front of a face of the 2 cm observation voxels keeps its observations on that side;
-// hits interpolated up to a TSDF voxel past the face still read them, grazing rays included.
+// hits and points interpolated up to a TSDF voxel past the face still read them, grazing rays
+// included.
 #include "reflectance/hit_radiance.h"
 
 #include <gtest/gtest.h>
@@ -61,6 +62,11 @@ TEST(HitRadiance, ReadsTheObservationsAcrossTheNearestVoxelFace) {
   EXPECT_FLOAT_EQ(radiance.x(), 0.25f);
   // 8 mm past the face, beyond a TSDF voxel: not the wall's.
   EXPECT_FALSE(hit_radiance(wall.grid, at(1.008f), grazing, kTsdfVoxel, blocks, radiance));
+
+  // The voxel holding the surface at a point (a re-rendered pixel's): the same faces, no ray.
+  EXPECT_EQ(observed_voxel(wall.grid, at(kWall), kTsdfVoxel, blocks), wall.observed);
+  EXPECT_EQ(observed_voxel(wall.grid, at(1.001f), kTsdfVoxel, blocks), wall.observed);
+  EXPECT_EQ(observed_voxel(wall.grid, at(1.008f), kTsdfVoxel, blocks), -1);
 }
 
 }  // namespace
