@@ -7,18 +7,18 @@
 
 namespace glint::reflectance {
 
-bool diffuse_radiance(const ObservationGrid& grid, int u, Eigen::Vector3f& radiance) {
+namespace {
+
+// The radiance observed voxel u sends every way: the colour of its observation of median
+// luminance (its highlights, seen from few directions, lie above it).
+Eigen::Vector3f diffuse_radiance(const ObservationGrid& grid, int u) {
   const int count = std::min(grid.observation_count(u), kMaxObservationsPerVoxel);
-  if (count == 0) return false;
   const Observation* observations = grid.observations(u);
   std::array<std::pair<float, int>, kMaxObservationsPerVoxel> luminance;
   for (int k = 0; k < count; ++k) luminance[std::size_t(k)] = {observations[k].colour().mean(), k};
   std::nth_element(luminance.begin(), luminance.begin() + count / 2, luminance.begin() + count);
-  radiance = observations[luminance[std::size_t(count / 2)].second].colour();
-  return true;
+  return observations[luminance[std::size_t(count / 2)].second].colour();
 }
-
-namespace {
 
 bool observed(const ObservationGrid& grid, int u) {
   return u >= 0 && grid.observation_count(u) > 0;
@@ -60,11 +60,12 @@ int observed_voxel(const ObservationGrid& grid, const Eigen::Vector3f& p, float 
 bool hit_radiance(const ObservationGrid& grid, const Eigen::Vector3f& h, const Eigen::Vector3f& d,
                   float tolerance, ObservationGrid::BlockCache& blocks, Eigen::Vector3f& radiance) {
   const float size = float(grid.params().voxel_size_m);
-  for (const float back : {0.0f, 0.5f})
-    if (const int u = grid.find(h - d * (back * size), &blocks); observed(grid, u))
-      return diffuse_radiance(grid, u, radiance);
-  const int u = observed_across_faces(grid, h, tolerance, blocks);
-  return u >= 0 && diffuse_radiance(grid, u, radiance);
+  int u = grid.find(h, &blocks);
+  if (!observed(grid, u)) u = grid.find(h - d * (0.5f * size), &blocks);
+  if (!observed(grid, u)) u = observed_across_faces(grid, h, tolerance, blocks);
+  if (u < 0) return false;
+  radiance = diffuse_radiance(grid, u);
+  return true;
 }
 
 }  // namespace glint::reflectance

@@ -9,10 +9,6 @@
 
 namespace glint::reflectance {
 
-// The radiance voxel u sends every way: the colour of its observation of median luminance (its
-// highlights, seen from few directions, lie above it). False where it has no observation.
-bool diffuse_radiance(const ObservationGrid& grid, int u, Eigen::Vector3f& radiance);
-
 // The voxel holding the surface at p: p's voxel where it has observations, else the neighbours
 // across the faces of p's voxel that lie within `tolerance` (the TSDF's voxel) of p and have
 // some, nearest first (a surface on a voxel face keeps its observations on one side, and a
