@@ -94,6 +94,17 @@ inline AlbedoVerdict judge_albedo(float refined, bool lower_bound, float referen
   return {false, std::max(0.0f, 1 - refined / reference)};
 }
 
+// A light shortfall re-judged by the albedo of the same observations with no specular term taken
+// out (`without_lobe`, its largest channel): where that is not too dark, the observations hold
+// the light, and the lobe, predicting more highlight than they show (a network's gloss on a matte
+// wall), made the albedo dark: still no estimate, but no light lacking.
+inline AlbedoVerdict judge_without_lobe(AlbedoVerdict verdict, float without_lobe, float reference,
+                                        float max_ratio) {
+  if (verdict.light_shortfall > 0 && without_lobe * max_ratio >= reference)
+    verdict.light_shortfall = 0;
+  return verdict;
+}
+
 // A voxel's observations reduced to the two sides of eq. (7): the diffuse radiance, each
 // observation's radiance less its specular term, combined by an AlbedoAverage, and the
 // irradiance it answers to. kd = pi * radiance / irradiance per channel (the average commutes

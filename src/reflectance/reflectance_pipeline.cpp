@@ -244,8 +244,19 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
         due_albedo_[i] = kd.maxCoeff();
         due_segment_[i] = segment;
       }
-      const AlbedoVerdict verdict =
+      AlbedoVerdict verdict =
           judge_albedo(kd.maxCoeff(), refined->lower_bound, reference, params_.albedo_max_ratio);
+      if (verdict.light_shortfall > 0) {
+        const auto bare =
+            observe_diffuse(grid_.observations(v), grid_.observation_count(v), grid_.position(v),
+                            grid_.normal(v), lights_, Eigen::Vector3f::Zero(), material->ward.alpha,
+                            params_.albedo_average, clipped, lighting);
+        const auto without_lobe =
+            bare ? solve_albedo(*bare, transport_.unseen(segment)) : std::nullopt;
+        if (without_lobe)
+          verdict = judge_without_lobe(verdict, without_lobe->kd.maxCoeff(), reference,
+                                       params_.albedo_max_ratio);
+      }
       grid_.light_shortfall(v) = verdict.light_shortfall;
       if (!verdict.estimate) continue;
       grid_.refined_kd_reliable(v) = trusted_light;

@@ -275,6 +275,55 @@ TEST(AlbedoRefinement, TooDarkAlbedosLackLightUnlessTheyAreLowerBounds) {
   EXPECT_TRUE(judge_albedo(0.0f, true, 0.4f, 0).estimate);
 }
 
+TEST(AlbedoRefinement, ALobeThatPredictsTooMuchHighlightLacksNoLight) {
+  // A matte wall seen near the mirror direction of its one light.
+  render::WardMaterial wall;
+  wall.kd = {0.6f, 0.6f, 0.6f};
+  wall.ks = {0.02f, 0.02f, 0.02f};
+  wall.alpha = 0.3f;
+  std::vector<render::PointLight> lights(1);
+  lights[0].position = {0.0, 1.0, -0.5};
+  lights[0].intensity = {2, 2, 2};
+  const Eigen::Vector3f position = Eigen::Vector3f::Zero(), normal = Eigen::Vector3f::UnitY();
+  const Eigen::Vector3f wi = (lights[0].position.cast<float>() - position).normalized();
+  const Eigen::Vector3f mirror = 2 * normal.dot(wi) * normal - wi;
+  std::vector<Observation> obs;
+  for (int k = 0; k < 7; ++k) {
+    const Eigen::Vector3f direction =
+        (mirror + 0.03f * Eigen::Vector3f(std::cos(0.9f * k), 0, std::sin(0.9f * k))).normalized();
+    obs.emplace_back(observed(wall, position, normal, direction, lights), direction, k);
+  }
+  const float reference = 0.6f, max_ratio = 3;
+  // A glossy lobe (a network's guess) takes out more than the wall reflects: eq. (7) leaves it
+  // dark, as an unseen shadow would.
+  const Eigen::Vector3f glossy(0.3f, 0.3f, 0.3f);
+  const auto dark = refine_albedo(obs.data(), int(obs.size()), position, normal, lights, glossy,
+                                  0.05f, AlbedoAverage::median);
+  ASSERT_TRUE(dark);
+  const AlbedoVerdict verdict = judge_albedo(dark->kd.maxCoeff(), false, reference, max_ratio);
+  ASSERT_GT(verdict.light_shortfall, 0.0f);
+  // Without the lobe the observations hold the light: no light lacking, still no estimate.
+  const auto bare = refine_albedo(obs.data(), int(obs.size()), position, normal, lights,
+                                  Eigen::Vector3f::Zero(), 0.05f, AlbedoAverage::median);
+  ASSERT_TRUE(bare);
+  EXPECT_NEAR(bare->kd.x(), 0.6f, 0.1f);  // the wall's own highlight on top
+  const AlbedoVerdict rejudged =
+      judge_without_lobe(verdict, bare->kd.maxCoeff(), reference, max_ratio);
+  EXPECT_FALSE(rejudged.estimate);
+  EXPECT_EQ(rejudged.light_shortfall, 0.0f);
+  // In an unseen shadow the observations lack the light with or without the lobe: it stays.
+  std::vector<Observation> shadowed;
+  for (const Observation& o : obs)
+    shadowed.emplace_back(0.05f * o.colour(), o.direction(), std::uint32_t(shadowed.size()));
+  const auto in_shadow =
+      refine_albedo(shadowed.data(), int(shadowed.size()), position, normal, lights,
+                    Eigen::Vector3f::Zero(), 0.05f, AlbedoAverage::median);
+  ASSERT_TRUE(in_shadow);
+  EXPECT_EQ(
+      judge_without_lobe(verdict, in_shadow->kd.maxCoeff(), reference, max_ratio).light_shortfall,
+      verdict.light_shortfall);
+}
+
 TEST(AlbedoRefinement, UnlitOrUnseenVoxelsHaveNoEstimate) {
   std::vector<render::PointLight> below(1);
   below[0].position = {0, -1, 0};
