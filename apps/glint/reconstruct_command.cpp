@@ -472,8 +472,10 @@ void register_reconstruct_command(CLI::App& app) {
                    "above the median of its segment's: the lights do not explain its "
                    "observations, most often a shadow cast by a part of the scene the camera "
                    "never saw (the shadow ray passes through it); the re-renderings and the mesh "
-                   "use the reliable voxels around it or the segment's albedo instead (0 = trust "
-                   "all, as the paper)")
+                   "use the reliable voxels around it or the segment's albedo instead, and where "
+                   "it is too dark they leave that light out, unless its observations without the "
+                   "specular lobe are bright enough (the lobe over-predicts a highlight) (0 = "
+                   "trust all, as the paper)")
       ->check(CLI::Validator(
           [](const std::string& text) -> std::string {
             char* end = nullptr;
