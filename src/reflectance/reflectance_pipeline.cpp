@@ -204,12 +204,14 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
           observe_diffuse(grid_.observations(v), grid_.observation_count(v), grid_.position(v),
                           grid_.normal(v), lights_, material->ward.ks, material->ward.alpha,
                           params_.albedo_average, clipped, lighting);
-      if (shadow_test)
-        transport_.set_occluded(
-            v, observed && known
-                   ? test_shadows(v, *material, albedo_reference_[std::size_t(segment)], lighting,
-                                  *occupancy, clipped, *observed)
-                   : 0);
+      if (shadow_test) {
+        const LightMask dropped =
+            observed && known ? test_shadows(v, *material, albedo_reference_[std::size_t(segment)],
+                                             lighting, *occupancy, clipped, *observed)
+                              : 0;
+        transport_.set_occluded(v, dropped);
+        lighting.lit &= ~dropped;  // the lights `observed` now answers to
+      }
       if (fit_unseen && observed && in_map && !observed->lower_bound &&
           (observed->sines == 0 || observed->sines <= max_light_tangent * observed->cosines)) {
         fit_segment_[i] = segment;
