@@ -200,10 +200,13 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
       PointLighting lighting = transport_.lighting(v);
       if (shadow_test) lighting.lit = transport_.cast_lights(v);
       lighting.mirrored = transport_.mirrored(grid_, v, mirrored);
-      auto observed =
-          observe_diffuse(grid_.observations(v), grid_.observation_count(v), grid_.position(v),
-                          grid_.normal(v), lights_, material->ward.ks, material->ward.alpha,
-                          params_.albedo_average, clipped, lighting);
+      // The voxel's observations under `lighting` less the specular term of `ks` (eq. (7)).
+      const auto observe = [&](const Eigen::Vector3f& ks) {
+        return observe_diffuse(grid_.observations(v), grid_.observation_count(v), grid_.position(v),
+                               grid_.normal(v), lights_, ks, material->ward.alpha,
+                               params_.albedo_average, clipped, lighting);
+      };
+      auto observed = observe(material->ward.ks);
       if (shadow_test) {
         const LightMask dropped =
             observed && known ? test_shadows(v, *material, albedo_reference_[std::size_t(segment)],
@@ -248,17 +251,11 @@ void ReflectancePipeline::refine_albedo_of_visible(const fusion::BlockOccupancy*
       }
       AlbedoVerdict verdict =
           judge_albedo(kd.maxCoeff(), refined->lower_bound, reference, params_.albedo_max_ratio);
-      if (verdict.light_shortfall > 0) {
-        const auto bare =
-            observe_diffuse(grid_.observations(v), grid_.observation_count(v), grid_.position(v),
-                            grid_.normal(v), lights_, Eigen::Vector3f::Zero(), material->ward.alpha,
-                            params_.albedo_average, clipped, lighting);
-        const auto without_lobe =
-            bare ? solve_albedo(*bare, transport_.unseen(segment)) : std::nullopt;
-        if (without_lobe)
-          verdict = judge_without_lobe(verdict, without_lobe->kd.maxCoeff(), reference,
-                                       params_.albedo_max_ratio);
-      }
+      if (verdict.light_shortfall > 0)
+        if (const auto bare = observe(Eigen::Vector3f::Zero()))
+          if (const auto without_lobe = solve_albedo(*bare, transport_.unseen(segment)))
+            verdict = judge_without_lobe(verdict, without_lobe->kd.maxCoeff(), reference,
+                                         params_.albedo_max_ratio);
       grid_.light_shortfall(v) = verdict.light_shortfall;
       if (!verdict.estimate) continue;
       grid_.refined_kd_reliable(v) = trusted_light;
