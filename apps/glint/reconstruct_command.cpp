@@ -316,6 +316,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"indirect_rays", options.params.light_transport.indirect_rays},
          {"indirect_rays_per_frame", options.params.light_transport.indirect_rays_per_frame},
          {"indirect_pooling", options.params.light_transport.indirect_pooling},
+         {"continue_plane", options.params.light_transport.continue_plane},
          {"indirect_scaled", options.params.light_transport.indirect_scaled},
          {"indirect_specular",
           reflectance::indirect_specular_name(options.params.light_transport.indirect_specular)},
@@ -595,6 +596,11 @@ void register_reconstruct_command(CLI::App& app) {
                     "neighbours on the same surface (within 26 degrees and half a voxel of its "
                     "tangent plane), so it has light after a few frames and less noise (off = "
                     "its own rays only)");
+  add_on_off_option(command, "--continue-plane", transport.continue_plane,
+                    "With --indirect on: gather and lobe rays that leave the reconstruction meet "
+                    "its largest plane (mostly the floor) continued beyond it, and bring that "
+                    "plane's albedo / pi times the lights' irradiance there (unshadowed); a floor "
+                    "scanned from one side goes on behind the camera (off = such rays are dark)");
   add_on_off_option(command, "--indirect-scale", transport.indirect_scaled,
                     "With --indirect on: scale the gathered light by what the voxels no light "
                     "reaches directly show (their brightness over the gather's prediction, the "

@@ -189,6 +189,8 @@ reflectance::ReflectanceParams params_from(const py::dict& options, std::string&
         p.light_transport.indirect_rays_per_frame = int(positive(value.cast<int>()));
       } else if (name == "indirect_pooling") {
         p.light_transport.indirect_pooling = value.cast<bool>();
+      } else if (name == "continue_plane") {
+        p.light_transport.continue_plane = value.cast<bool>();
       } else if (name == "indirect_scale") {
         p.light_transport.indirect_scaled = value.cast<bool>();
       } else if (name == "indirect_specular") {
@@ -382,7 +384,7 @@ Keyword options (the CLI's names, '_' for '-', and its defaults):
     albedo_max_ratio=3, albedo_max_indirect=0.5, albedo_shrinkage=True, albedo_normal_error=0.05,
     albedo_smoothing=0.2, shadows=True, shadow_test=True, shadow_test_sigmas=2, indirect=True,
     indirect_scale=True, indirect_specular='mirror', unseen_light=False, indirect_rays=64,
-    indirect_rays_per_frame=2, indirect_pooling=True, ray_offset=0.01,
+    indirect_rays_per_frame=2, indirect_pooling=True, continue_plane=True, ray_offset=0.01,
     specular='hemicnn+fit' ('hemicnn'), normals='plane' ('gradient'), seed=1,
     render_normal_radius=0.02.
 

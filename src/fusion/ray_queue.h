@@ -34,6 +34,7 @@ class RayQueue {
   int size() const { return int(origins_.size()); }
   const Eigen::Vector3f& origin(int ray) const { return origins_[std::size_t(ray)]; }
   const Eigen::Vector3f& direction(int ray) const { return directions_[std::size_t(ray)]; }
+  float t_max(int ray) const { return t_max_[std::size_t(ray)]; }
   // Where ray `ray` ended once marched: MarchEnd::t > 0 at a + to - crossing, back_face where it
   // entered a surface from behind, neither where it met none.
   const MarchEnd& end(int ray) const { return ends_[std::size_t(ray)]; }

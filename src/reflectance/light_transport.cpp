@@ -133,23 +133,48 @@ void queue_gather_rays(const ObservationGrid& grid, int v, int rays,
   }
 }
 
-// The radiance marched gather ray `ray` brings: none where it left the reconstruction or met a
-// light's proxy or a clipped surface (their light is direct); false where it is unknown (a back
-// face, a surface never observed), which is not counted.
-bool gathered_radiance(const fusion::RayQueue& queue, int ray, const ObservationGrid& grid,
-                       const std::vector<render::PointLight>& lights, float margin,
-                       float saturated_radiance, ObservationGrid::BlockCache& blocks,
-                       Eigen::Vector3f& radiance) {
+// What a marched gather or lobe ray's end is judged by (gathered_radiance()).
+struct RayEnds {
+  const ObservationGrid& grid;
+  const std::vector<render::PointLight>& lights;
+  float margin;  // a hit this close to a light's proxy lies on it, or in a voxel it shares
+  float saturated_radiance;
+  const ContinuedPlane& plane;  // met beyond the reconstruction's box
+  float max_distance_m;
+};
+
+// The ends of the rays from `grid`'s voxels under `lights`.
+RayEnds ray_ends(const ObservationGrid& grid, const std::vector<render::PointLight>& lights,
+                 const LightTransportParams& params, const ContinuedPlane& plane) {
+  return {.grid = grid,
+          .lights = lights,
+          .margin = 2 * float(grid.params().voxel_size_m),
+          .saturated_radiance = params.saturated_radiance,
+          .plane = plane,
+          .max_distance_m = params.indirect_max_distance_m};
+}
+
+// The radiance marched gather ray `ray` brings: none where it met a light's proxy or a clipped
+// surface (their light is direct) or left the reconstruction, unless it then meets the continued
+// plane within the rays' reach; false where it is unknown (a back face, a surface never
+// observed), which is not counted.
+bool gathered_radiance(const fusion::RayQueue& queue, int ray, const RayEnds& ends,
+                       ObservationGrid::BlockCache& blocks, Eigen::Vector3f& radiance) {
   const fusion::MarchEnd& hit = queue.end(ray);
   if (hit.back_face) return false;
   radiance = Eigen::Vector3f::Zero();
-  if (!(hit.t > 0)) return true;
   const Eigen::Vector3f& direction = queue.direction(ray);
+  if (!(hit.t > 0)) {
+    const float t = ends.plane.hit(queue.origin(ray), direction);
+    if (t > queue.t_max(ray) && t <= ends.max_distance_m)
+      radiance = ends.plane.radiance(queue.origin(ray) + t * direction, ends.lights);
+    return true;
+  }
   const Eigen::Vector3f h = queue.origin(ray) + direction * hit.t;
-  if (!on_light(lights, h, margin) &&
-      !hit_radiance(grid, h, direction, queue.voxel_m(), blocks, radiance))
+  if (!on_light(ends.lights, h, ends.margin) &&
+      !hit_radiance(ends.grid, h, direction, queue.voxel_m(), blocks, radiance))
     return false;
-  if (!(radiance.maxCoeff() < saturated_radiance)) radiance = Eigen::Vector3f::Zero();
+  if (!(radiance.maxCoeff() < ends.saturated_radiance)) radiance = Eigen::Vector3f::Zero();
   return true;
 }
 
@@ -185,13 +210,11 @@ constexpr int kObservationLobeRays = 1;
 // The mean radiance of `count` marched lobe rays from `first` (gathered_radiance()), NaN where
 // none is known.
 Eigen::Vector3f lobe_radiance(const fusion::RayQueue& queue, int first, int count,
-                              const ObservationGrid& grid,
-                              const std::vector<render::PointLight>& lights, float margin,
-                              float saturated_radiance, ObservationGrid::BlockCache& blocks) {
+                              const RayEnds& ends, ObservationGrid::BlockCache& blocks) {
   Eigen::Vector3f sum = Eigen::Vector3f::Zero(), radiance;
   int known = 0;
   for (int ray = first; ray < first + count; ++ray)
-    if (gathered_radiance(queue, ray, grid, lights, margin, saturated_radiance, blocks, radiance)) {
+    if (gathered_radiance(queue, ray, ends, blocks, radiance)) {
       sum += radiance;
       ++known;
     }
@@ -406,8 +429,7 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
     return;
   }
   const WorldBox box(occupancy, volume);
-  // A hit this close to a light's proxy lies on it, or in an observation voxel it shares.
-  const float margin = 2 * float(grid.params().voxel_size_m);
+  const RayEnds ends = ray_ends(grid, lights, params_, plane_);
   parallel_for_chunks(due_.size(), kVoxelsPerQueue, [&](std::size_t begin, std::size_t end) {
     fusion::RayQueue queue(volume, &occupancy);
     ObservationGrid::BlockCache blocks;
@@ -428,9 +450,7 @@ void LightTransport::update_indirect(const ObservationGrid& grid, const fusion::
         const int v = due_[i];
         for (int k = 0; k < ray_count[i - batch]; ++k, ++ray) {
           Eigen::Vector3f radiance;
-          if (!gathered_radiance(queue, ray, grid, lights, margin, params_.saturated_radiance,
-                                 blocks, radiance))
-            continue;
+          if (!gathered_radiance(queue, ray, ends, blocks, radiance)) continue;
           if (indirect_rays_[v] < n) {
             indirect_sum_[v] += radiance;
             ++indirect_rays_[v];
@@ -451,7 +471,7 @@ void LightTransport::update_mirrors(const ObservationGrid& grid, const fusion::T
                                     const std::function<float(int)>& alpha) {
   if (!mirrors()) return;
   const WorldBox box(occupancy, volume);
-  const float margin = 2 * float(grid.params().voxel_size_m);
+  const RayEnds ends = ray_ends(grid, lights, params_, plane_);
   parallel_for_chunks(voxels.size(), kVoxelsPerQueue, [&](std::size_t begin, std::size_t end) {
     fusion::RayQueue queue(volume, &occupancy);
     ObservationGrid::BlockCache blocks;
@@ -486,8 +506,7 @@ void LightTransport::update_mirrors(const ObservationGrid& grid, const fusion::T
       }
       queue.march();
       for (const Cast& cast : casts) {
-        const Eigen::Vector3f radiance = lobe_radiance(queue, cast.first, cast.count, grid, lights,
-                                                       margin, params_.saturated_radiance, blocks);
+        const Eigen::Vector3f radiance = lobe_radiance(queue, cast.first, cast.count, ends, blocks);
         if (!radiance.allFinite()) continue;
         MirrorSample& sample = mirror_[cast.slot];
         for (int c = 0; c < 3; ++c) sample.radiance[std::size_t(c)] = half_from_float(radiance[c]);
@@ -528,8 +547,7 @@ Eigen::Vector3f LightTransport::mirror_radiance(
       queue_lobe_rays(queue, kPixelLobeRays, p, n, wo, alpha, mix(params_.seed ^ place_hash(bits)),
                       params_, WorldBox(occupancy, volume));
   queue.march();
-  return lobe_radiance(queue, 0, count, grid, lights, 2 * float(grid.params().voxel_size_m),
-                       params_.saturated_radiance, blocks) *
+  return lobe_radiance(queue, 0, count, ray_ends(grid, lights, params_, plane_), blocks) *
          mirror_scale();
 }
 

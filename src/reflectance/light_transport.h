@@ -13,9 +13,10 @@
 //    estimate E = pi / n * sum_k L(w_k) (cosine-weighted directions, pdf cos / pi) accumulates a
 //    few rays every few frames the voxel is seen, up to indirect_rays, then follows the changing
 //    reconstruction as a moving average of that many rays, one ray every
-//    indirect_refresh_frames frames. A ray that leaves the reconstruction counts as dark; one that
-//    hits a surface never observed, or one from behind, is not counted (no radiance is known
-//    there). Indirect irradiance varies slowly along a surface, so a voxel's estimate pools the
+//    indirect_refresh_frames frames. A ray that leaves the reconstruction counts as dark unless
+//    it then meets the largest plane continued beyond it (continue_plane, ContinuedPlane); one
+//    that hits a surface never observed, or one from behind, is not counted (no radiance is
+//    known there). Indirect irradiance varies slowly along a surface, so a voxel's estimate pools the
 //    rays of its neighbours on the same surface (indirect_pooling): a new voxel gets its light
 //    after a few frames rather than after indirect_min_rays of its own rays, and with several
 //    times the rays;
@@ -45,6 +46,7 @@
 #include "fusion/block_occupancy.h"
 #include "fusion/ray_queue.h"
 #include "fusion/tsdf_volume.h"
+#include "reflectance/continued_plane.h"
 #include "reflectance/light_incidence.h"
 #include "reflectance/observation_grid.h"
 #include "reflectance/unseen_light.h"
@@ -129,6 +131,10 @@ struct LightTransportParams {
   // surface (pools_indirect_rays()): on its own rays alone a voxel seen every frame needs 16
   // frames to reach indirect_min_rays (docs/decisions.md, "The gather pools its neighbours' rays").
   bool indirect_pooling = true;
+  // Gather and lobe rays that leave the reconstruction meet its largest plane continued beyond
+  // it (ContinuedPlane; the pipeline finds the plane), where they would count as dark: a floor
+  // seen from one side goes on behind the camera.
+  bool continue_plane = true;
   // Multiply every voxel's gathered irradiance by one scene scale measured where no light
   // reaches directly: there a voxel's diffuse radiance is kd / pi * E_true, so its albedo solved
   // under the gathered E alone, over its segment's reference, is E_true / E (ReflectancePipeline
@@ -305,6 +311,10 @@ class LightTransport {
   void fuse_unseen(int segment, const RadianceLine& line);
   // Rays counted in voxel v's own indirect estimate (not its neighbours' it pools).
   int indirect_rays(int v) const { return indirect_rays_[v]; }
+  // The plane that gather and lobe rays leaving the reconstruction meet beyond it (not known():
+  // none; ContinuedPlane).
+  void set_continued_plane(const ContinuedPlane& plane) { plane_ = plane; }
+  const ContinuedPlane& continued_plane() const { return plane_; }
 
  private:
   LightTransportParams params_;
@@ -328,6 +338,7 @@ class LightTransport {
   // indirect_ of the due voxels from the rays gathered so far (their own or their pool's).
   void estimate_indirect(const ObservationGrid& grid);
   std::vector<int> due_;  // scratch: the voxels due in a frame
+  ContinuedPlane plane_;
   std::shared_ptr<const render::EmbreeScene> true_scene_;
   std::shared_ptr<const render::Renderer> true_indirect_;
   // Per segment id: its fused radiance line and the frames fused into it.

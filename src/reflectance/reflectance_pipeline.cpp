@@ -133,6 +133,15 @@ LightMask ReflectancePipeline::test_shadows(int v, const SegmentMaterial& materi
   return dropped;
 }
 
+void ReflectancePipeline::continue_largest_plane() {
+  // A plane as thick as an observation voxel: its voxels' positions scatter by less.
+  transport_.set_continued_plane(
+      largest_plane(grid_, float(grid_.params().voxel_size_m), [&](int segment) {
+        const SegmentMaterial* material = specular_.material(segment);
+        return material ? material->ward.kd : Eigen::Vector3f::Constant(NAN);
+      }));
+}
+
 void ReflectancePipeline::collect_albedo_due() {
   // Due: voxels never refined, and those whose turn in the refresh cycle it is.
   albedo_due_.clear();
@@ -389,6 +398,9 @@ ReflectanceFrame ReflectancePipeline::process(const io::RgbdFrame& frame,
     transport_.update_shadows(grid_, geometry_.volume(), *occupancy, lights_, frame_);
     timings_.add("shadows", stage.elapsed_ms());
     stage.restart();
+    if (transport_.params().indirect && transport_.params().continue_plane &&
+        frame_ % kPlaneEveryFrames == 0)
+      continue_largest_plane();
     transport_.update_indirect(grid_, geometry_.volume(), *occupancy, lights_, frame_);
     timings_.add("indirect", stage.elapsed_ms());
     stage.restart();

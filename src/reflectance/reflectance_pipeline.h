@@ -160,6 +160,10 @@ class ReflectancePipeline {
  private:
   // The voxels whose albedo is due this frame (albedo_due_).
   void collect_albedo_due();
+  // Hands the light transport the largest plane so far, with its segment's kd (ContinuedPlane),
+  // every kPlaneEveryFrames frames: a floor changes little from frame to frame.
+  void continue_largest_plane();
+  static constexpr int kPlaneEveryFrames = 4;
   // Solves the due voxels' albedo (eq. 7), and fuses each segment's mean over its reliable ones
   // into its SegmentMaterial::kd_refined: the albedo a re-rendering falls back on where no voxel
   // nearby has one (unlit or unobserved parts; the paper assumes a segment homogeneous).

@@ -99,6 +99,12 @@ class BoxScene {
 
   const fusion::TsdfVolume& geometry() const { return geometry_; }
   const ObservationGrid& grid() const { return grid_; }
+  // Gives each surface voxel the segment segment_of(its position).
+  template <class SegmentOf>
+  void label(SegmentOf segment_of) {
+    for (int v = 0; v < int(grid_.voxel_count()); ++v)
+      if (grid_.has_surface(v)) grid_.segment(v) = segment_of(grid_.position(v));
+  }
 
  private:
   static fusion::VolumeParams volume_params() {
@@ -297,6 +303,8 @@ class WallBesideFloor {
     return transport;
   }
   const ObservationGrid& grid() const { return scene_.grid(); }
+  BoxScene& boxes() { return scene_; }
+  const render::PointLight& light() const { return light_; }
   // The wall's radiance at point w of its face.
   double wall_radiance(const Eigen::Vector3d& w) const {
     return 0.9 / M_PI * direct(w, Eigen::Vector3d::UnitX());
@@ -364,6 +372,85 @@ TEST(LightTransport, GatheredIndirectIrradianceOfAFloorBesideAWhiteWallMatchesAQ
   // Off: no indirect light.
   LightTransport off({.shadows = false, .indirect = false}, 16);
   EXPECT_TRUE(off.lighting(scene.any_voxel()).indirect.isZero());
+}
+
+// The floor's segment (more voxels) is the largest plane; without its albedo, the wall's face;
+// the two as one segment are no plane.
+TEST(ContinuedPlane, TheLargestPlanarSegmentWithAnAlbedoIsContinued) {
+  WallBesideFloor scene;
+  scene.boxes().label([](const Eigen::Vector3f& p) {
+    return std::abs(p.y()) < 0.01f ? 1 : std::abs(p.x()) < 0.01f ? 2 : 3;  // 3: the boxes' sides
+  });
+  const auto albedo_of = [](Eigen::Vector3f floor) {
+    return [floor](int segment) { return segment == 1 ? floor : Eigen::Vector3f::Constant(0.9f); };
+  };
+  const ContinuedPlane floor = largest_plane(scene.grid(), 0.02f, albedo_of({0.3f, 0.3f, 0.3f}));
+  EXPECT_GT(floor.normal.y(), 0.999f);
+  EXPECT_NEAR(floor.offset, 0.0f, 0.005f);
+  EXPECT_FLOAT_EQ(floor.albedo.x(), 0.3f);
+  const ContinuedPlane wall =
+      largest_plane(scene.grid(), 0.02f, albedo_of(Eigen::Vector3f::Constant(NAN)));
+  EXPECT_GT(wall.normal.x(), 0.999f);
+  EXPECT_NEAR(wall.offset, 0.0f, 0.005f);
+  scene.boxes().label([](const Eigen::Vector3f& p) {
+    return std::abs(p.y()) < 0.01f || std::abs(p.x()) < 0.01f ? 1 : 3;
+  });
+  EXPECT_FALSE(largest_plane(scene.grid(), 0.02f, albedo_of({0.3f, 0.3f, 0.3f})).known());
+}
+
+// The wall continued beyond the reconstruction's box: the floor's gather rays that leave the box
+// above or beside the wall and meet its plane there bring the wall's model radiance, which is the
+// scene's own wall radiance (kd 0.9, Lambertian under the light). What that adds to each floor
+// voxel's gathered light matches a quadrature of the wall's plane outside the box (2 cm cells up
+// to 10 m: the rays' reach), within 10 % per voxel (a tenth of 4096 rays meet it) and 3 % on
+// their mean.
+TEST(LightTransport, RaysLeavingTheReconstructionMeetTheContinuedPlaneBeyondIt) {
+  WallBesideFloor scene;
+  LightTransportParams params{.shadows = false, .indirect = true, .indirect_rays = 4096};
+  params.indirect_scaled = false;
+  params.indirect_pooling = false;
+  params.indirect_rays_per_frame = params.indirect_rays;
+  params.indirect_every_frames = 1;
+  const fusion::BlockOccupancy occupancy(scene.boxes().geometry());
+  Eigen::Vector3i low_block, high_block;
+  ASSERT_TRUE(occupancy.bounds(low_block, high_block));
+  const double block = scene.boxes().geometry().params().block_size_m();
+  const Eigen::Vector3d low = low_block.cast<double>() * block,
+                        high = (high_block + Eigen::Vector3i::Ones()).cast<double>() * block;
+  const auto gathered = [&](const ContinuedPlane& plane) {
+    LightTransport transport(params, scene.grid().voxel_pool_size());
+    transport.set_continued_plane(plane);
+    transport.update_indirect(scene.grid(), scene.boxes().geometry(), occupancy, {scene.light()},
+                              0);
+    return transport;
+  };
+  const LightTransport without = gathered({});
+  const LightTransport with =
+      gathered({.normal = Eigen::Vector3f::UnitX(), .offset = 0, .albedo = {0.9f, 0.9f, 0.9f}});
+  double sum_ratio = 0;
+  const std::vector<int> voxels = scene.floor_voxels();
+  ASSERT_GT(voxels.size(), 20u);
+  for (const int v : voxels) {
+    const Eigen::Vector3d p = scene.position(v).cast<double>();
+    const Eigen::Vector3d origin = p + params.ray_offset_m * Eigen::Vector3d::UnitY();
+    constexpr double kCell = 0.02;
+    double expected = 0;
+    for (double y = kCell / 2; y < 10; y += kCell)
+      for (double z = -10 + kCell / 2; z < 10; z += kCell) {
+        const Eigen::Vector3d w(0, y, z), d = w - origin;
+        if (y <= high.y() && z >= low.z() && z <= high.z()) continue;  // inside the box
+        const double d2 = d.squaredNorm();
+        const double cos_p = d.y() / std::sqrt(d2), cos_w = -d.x() / std::sqrt(d2);
+        if (cos_p > 0 && cos_w > 0 &&
+            d2 <= params.indirect_max_distance_m * params.indirect_max_distance_m)
+          expected += scene.wall_radiance(w) * cos_p * cos_w / d2;
+      }
+    expected *= kCell * kCell;
+    const double added = with.lighting(v).indirect.x() - without.lighting(v).indirect.x();
+    EXPECT_NEAR(added, expected, 0.1 * expected) << p.transpose();
+    sum_ratio += added / expected;
+  }
+  EXPECT_NEAR(sum_ratio / double(voxels.size()), 1.0, 0.03);
 }
 
 TEST(LightTransport, APooledEstimateHasLightBeforeItsVoxelHasEnoughRaysOfItsOwn) {
