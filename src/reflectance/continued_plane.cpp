@@ -3,17 +3,15 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 
+#include "reflectance/light_incidence.h"
+
 namespace glint::reflectance {
 
 Eigen::Vector3f ContinuedPlane::radiance(const Eigen::Vector3f& p,
                                          const std::vector<render::PointLight>& lights) const {
   Eigen::Vector3f irradiance = Eigen::Vector3f::Zero();
-  for (const render::PointLight& light : lights) {
-    const Eigen::Vector3f to_light = light.position.cast<float>() - p;
-    const float distance2 = to_light.squaredNorm();
-    const float cosine = normal.dot(to_light) / std::sqrt(distance2);
-    if (cosine > 0) irradiance += light.intensity * (cosine / distance2);
-  }
+  for (const render::PointLight& light : lights)
+    irradiance += incidence(light, p, normal).irradiance;
   return albedo.cwiseProduct(irradiance) / float(M_PI);
 }
 
