@@ -85,6 +85,13 @@ void add_on_off_option(CLI::App* command, const std::string& name, bool& flag,
       ->default_str(flag ? "on" : "off");
 }
 
+// The plane that gather and lobe rays leaving the reconstruction met at the end (null: none).
+nlohmann::json continued_plane_json(const reflectance::ContinuedPlane& plane) {
+  if (!plane.known()) return nullptr;
+  const auto array = [](const Eigen::Vector3f& v) { return nlohmann::json{v.x(), v.y(), v.z()}; };
+  return {{"normal", array(plane.normal)}, {"offset_m", plane.offset}, {"kd", array(plane.albedo)}};
+}
+
 reflectance::LightEstimate load_lights(const ReconstructOptions& options) {
   if (options.ground_truth_lights) {
     const std::string scene_path = (fs::path(options.sequence) / "scene.json").string();
@@ -326,6 +333,7 @@ void run_reconstruct(ReconstructOptions options) {
          {"lights", lights.capture}}},
        {"indirect_scale", pipeline.light_transport().indirect_scale()},
        {"indirect_error", pipeline.light_transport().indirect_error()},
+       {"continued_plane", continued_plane_json(pipeline.light_transport().continued_plane())},
        {"timings_ms", timings.to_json()},
        {"geometry_timings_ms", pipeline.geometry_timings().to_json()},
        {"command_timings_ms", command},

@@ -70,6 +70,11 @@ TEST_F(ReconstructCli, WritesTheModelMaterialsLightsPicturesAndReport) {
   EXPECT_FLOAT_EQ(report["parameters"]["shadow_test_sigmas"].get<float>(), 2.0f);
   // Without bounced light the scale's samples are all 0: no spread to measure.
   EXPECT_EQ(report["indirect_error"].get<float>(), 0.0f);
+  // The plane rays leaving the reconstruction meet: the floor, the cubes scene's largest.
+  EXPECT_TRUE(report["parameters"]["continue_plane"].get<bool>());
+  ASSERT_TRUE(report["continued_plane"].is_object());
+  EXPECT_GT(report["continued_plane"]["normal"][1].get<float>(), 0.99f);
+  EXPECT_NEAR(report["continued_plane"]["offset_m"].get<float>(), 0.0f, 0.02f);
   EXPECT_EQ(report["parameters"]["model_input"], "radiance");  // HemiCnn's default config
   EXPECT_EQ(report["parameters"]["integration_device"],
             fusion::CudaIntegrator::available() ? "cuda" : "cpu");
