@@ -16,8 +16,8 @@
 //    indirect_refresh_frames frames. A ray that leaves the reconstruction counts as dark unless
 //    it then meets the largest plane continued beyond it (continue_plane, ContinuedPlane); one
 //    that hits a surface never observed, or one from behind, is not counted (no radiance is
-//    known there). Indirect irradiance varies slowly along a surface, so a voxel's estimate pools the
-//    rays of its neighbours on the same surface (indirect_pooling): a new voxel gets its light
+//    known there). Indirect irradiance varies slowly along a surface, so a voxel's estimate pools
+//    the rays of its neighbours on the same surface (indirect_pooling): a new voxel gets its light
 //    after a few frames rather than after indirect_min_rays of its own rays, and with several
 //    times the rays;
 //  - one scale for the whole scene's gathered light (indirect_scaled), measured where no light
