@@ -88,8 +88,9 @@ void add_on_off_option(CLI::App* command, const std::string& name, bool& flag,
 // The plane that gather and lobe rays leaving the reconstruction met at the end (null: none).
 nlohmann::json continued_plane_json(const reflectance::ContinuedPlane& plane) {
   if (!plane.known()) return nullptr;
-  const auto array = [](const Eigen::Vector3f& v) { return nlohmann::json{v.x(), v.y(), v.z()}; };
-  return {{"normal", array(plane.normal)}, {"offset_m", plane.offset}, {"kd", array(plane.albedo)}};
+  return {{"normal", io::vector_json(plane.normal)},
+          {"offset_m", plane.offset},
+          {"kd", io::vector_json(plane.albedo)}};
 }
 
 reflectance::LightEstimate load_lights(const ReconstructOptions& options) {

@@ -1,10 +1,10 @@
 #pragma once
 // ContinuedPlane: the largest plane of the reconstruction (mostly its floor), continued beyond
 // what the camera saw. A gather or lobe ray that leaves the reconstruction counts as dark, yet on
-// a floor scanned from one side the rays aimed at the floor behind the camera meet lit floor (on
-// bunnies rendered with bounces, 40 % of an object's downward gather rays leave). Beyond the
-// reconstruction's box such a ray meets the plane instead and brings the plane's diffuse
-// radiance under the lights there, unshadowed: nothing is known out there.
+// a floor scanned from one side the rays aimed at the floor behind the camera meet lit floor.
+// Beyond the reconstruction's box such a ray meets the plane instead and brings the plane's
+// diffuse radiance under the lights there, unshadowed: nothing is known out there
+// (docs/decisions.md, "The largest plane continues beyond the reconstruction").
 #include <Eigen/Core>
 #include <functional>
 #include <limits>
