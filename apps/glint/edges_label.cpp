@@ -1,15 +1,22 @@
-// glint edges label: ground-truth labels for a user's own CAD part (STEP in, labelled cloud out).
+// glint edges label: ground-truth labels for a user's own CAD part (STEP) or triangle mesh (OBJ,
+// PLY), labelled cloud out.
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <memory>
 
+#include "cad/part.h"
 #include "cad/sample.h"
 #include "cad/step.h"
+#include "cad/surface_mesh.h"
 #include "cli_support.h"
 #include "commands.h"
+#include "core/error.h"
 #include "io/json_report.h"
 #include "io/ply.h"
+#include "render/mesh_loader.h"
 
 namespace glint::app {
 namespace {
@@ -19,28 +26,98 @@ struct LabelOptions {
   std::string output;
   std::string sampling = "uniform";
   std::string report;
+  std::vector<double> cut_plane;  // normal x, y, z and an optional offset in diagonals
+  bool deflection_given = false;
   cad::SampleParams params;
 };
+
+bool is_step(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return extension == ".step" || extension == ".stp";
+}
+
+// The plane of --cut-plane: through the bounding box's centre moved `offset` diagonals along
+// the normal.
+struct CutPlane {
+  Eigen::Vector3d point, normal;
+};
+
+CutPlane cut_plane(const std::vector<double>& values, const Eigen::Vector3d& low,
+                   const Eigen::Vector3d& high) {
+  const Eigen::Vector3d normal(values[0], values[1], values[2]);
+  if (!(normal.norm() > 0) || !normal.allFinite())
+    throw Error("--cut-plane", fmt::format("{}", fmt::join(values, ",")),
+                "the normal must be finite and non-zero");
+  const double offset = values.size() > 3 ? values[3] : 0.0;
+  return {0.5 * (low + high) + offset * (high - low).norm() * normal.normalized(),
+          normal.normalized()};
+}
+
+cad::LabelledCloud label_mesh(const LabelOptions& options, nlohmann::json& cut) {
+  if (options.deflection_given)
+    throw Error(options.input, "--deflection",
+                "applies to STEP parts, whose surfaces glint tessellates; a mesh is sampled as "
+                "it is (--plane-edge splits its long edges)");
+  const render::TriangleMesh loaded = render::load_mesh(options.input);
+  cad::SurfaceMesh mesh;
+  mesh.vertices.reserve(loaded.vertices.size());
+  for (const Eigen::Vector3f& v : loaded.vertices) mesh.vertices.push_back(v.cast<double>());
+  for (const Eigen::Vector3i& t : loaded.triangles) mesh.triangles.push_back({t[0], t[1], t[2]});
+  if (!options.cut_plane.empty()) {
+    Eigen::Vector3d low = mesh.vertices.front(), high = low;
+    for (const Eigen::Vector3d& v : mesh.vertices) low = low.cwiseMin(v), high = high.cwiseMax(v);
+    const CutPlane plane = cut_plane(options.cut_plane, low, high);
+    try {
+      mesh = cad::cut_mesh(mesh, plane.point, plane.normal);
+    } catch (const Error& e) {
+      throw Error(options.input, "--cut-plane", e.reason());
+    }
+    cut = {{"point", {plane.point.x(), plane.point.y(), plane.point.z()}},
+           {"normal", {plane.normal.x(), plane.normal.y(), plane.normal.z()}}};
+  }
+  return cad::sample_mesh(std::move(mesh), options.params, options.input);
+}
+
+cad::LabelledCloud label_step(const LabelOptions& options, nlohmann::json& cut) {
+  TopoDS_Shape shape = cad::read_step(options.input);
+  if (!options.cut_plane.empty()) {
+    const auto [low, high] = cad::shape_bounds(shape);
+    const CutPlane plane = cut_plane(options.cut_plane, low, high);
+    try {
+      shape = cad::cut_open(shape, plane.point.data(), plane.normal.data());
+    } catch (const Error& e) {
+      throw Error(options.input, "--cut-plane", e.reason());
+    }
+    cut = {{"point", {plane.point.x(), plane.point.y(), plane.point.z()}},
+           {"normal", {plane.normal.x(), plane.normal.y(), plane.normal.z()}}};
+  }
+  return cad::sample_shape(shape, options.params);
+}
 
 void run_label(LabelOptions options) {
   options.params.sampling = cad::parse_sampling(options.sampling);
   cad::check_sample_params(options.params);
-  const TopoDS_Shape shape = cad::read_step(options.input);
-  cad::LabelledCloud labelled = cad::sample_shape(shape, options.params);
+  nlohmann::json cut;
+  const bool step = is_step(options.input);
+  cad::LabelledCloud labelled = step ? label_step(options, cut) : label_mesh(options, cut);
   io::write_ply(options.output, labelled.cloud);
   const nlohmann::json& d = labelled.description;
+  const nlohmann::json& feature_edges = d[step ? "brep_edges" : "mesh_edges"];
   fmt::print(
-      "{}: {} points ({} non-edge, {} sharp, {} boundary), median spacing {:.4g}; B-rep "
-      "edges: {} sharp, {} smooth, {} boundary\n",
+      "{}: {} points ({} non-edge, {} sharp, {} boundary), median spacing {:.4g}; {} edges: {} "
+      "sharp, {} smooth, {} boundary\n",
       options.output, d["points"].get<std::size_t>(), d["labels"]["non-edge"].get<std::size_t>(),
       d["labels"]["sharp-edge"].get<std::size_t>(), d["labels"]["boundary"].get<std::size_t>(),
-      d["median_spacing"].get<double>(), d["brep_edges"]["sharp"].get<int>(),
-      d["brep_edges"]["smooth"].get<int>(), d["brep_edges"]["boundary"].get<int>());
+      d["median_spacing"].get<double>(), step ? "B-rep" : "mesh", feature_edges["sharp"].get<int>(),
+      feature_edges["smooth"].get<int>(), feature_edges["boundary"].get<int>());
   if (!options.report.empty())
     io::write_json(options.report, {{"command_line", command_line()},
                                     {"input", options.input},
                                     {"output", options.output},
                                     {"seed", options.params.seed},
+                                    {"cut_plane", cut},
                                     {"cloud", d}});
 }
 
@@ -51,27 +128,36 @@ void register_edges_label(CLI::App& edges) {
   cad::SampleParams& p = options->params;
   CLI::App* command = edges.add_subcommand(
       "label",
-      "Make a labelled ground-truth cloud from a CAD part (STEP): sharp edges and open "
-      "borders from the B-rep");
+      "Make a labelled ground-truth cloud from a CAD part (STEP) or a triangle mesh (OBJ, PLY): "
+      "sharp edges and open borders from the B-rep or the mesh's edges");
   command->footer(
       "Reads every shape of PART.step (OpenCASCADE), samples its surface and labels each point\n"
       "from the B-rep, never from the points: 1 (sharp) within --band local spacings of an edge\n"
       "whose two faces' normals turn by >= --sharp-angle degrees somewhere along it (fillets and\n"
       "other tangent blends are not sharp; a 45-degree chamfer edge is), 2 (boundary) within\n"
       "--boundary-band spacings of an edge with one face (open surfaces, removed faces), 0\n"
-      "otherwise. The output PLY has x y z and uchar 'label', in the STEP file's coordinates\n"
-      "(millimetres), ready for `glint edges eval` or `glint edges train`.\n"
+      "otherwise. The output PLY has x y z and uchar 'label', in the input's coordinates\n"
+      "(a STEP file's in millimetres), ready for `glint edges eval` or `glint edges train`.\n"
+      "A mesh (.obj, .ply with faces; an ABC model's OBJ, say) is labelled the same way from its\n"
+      "own edges: an edge is sharp where its two triangles' normals turn by >= --sharp-angle, a\n"
+      "boundary where it has one triangle. That suits meshes whose curved parts are finely\n"
+      "tessellated (a few degrees between neighbouring triangles); on a coarse mesh, creases of\n"
+      "the tessellation itself pass the angle.\n"
       "Samplings: 'uniform' (--points random points on the surface), 'vertices' (the nodes of\n"
-      "the kernel's tessellation with --deflection, as ABC clouds are), 'scan' (1..--viewpoints\n"
-      "simulated scanners: scan lines, falling density, occlusion holes; what no scanner sees\n"
-      "borders the cloud and is labelled boundary). --noise moves points along the normal.\n"
+      "the kernel's tessellation with --deflection, as ABC clouds are, or the mesh's own\n"
+      "vertices), 'scan' (1..--viewpoints simulated scanners: scan lines, falling density,\n"
+      "occlusion holes; what no scanner sees borders the cloud and is labelled boundary).\n"
+      "--noise moves points along the normal. --cut-plane opens the surface (no cap), as real\n"
+      "data is open: the cut's border is labelled boundary.\n"
       "Examples:\n"
       "  glint edges label bracket.step -o bracket.ply\n"
       "  glint edges label bracket.step -o bracket-mesh.ply --sampling vertices --deflection "
       "0.001\n"
       "  glint edges label bracket.step -o bracket-scan.ply --sampling scan --viewpoints 2 "
-      "--noise 0.5\n");
-  command->add_option("part", options->input, "STEP file (.step / .stp)")->required();
+      "--noise 0.5\n"
+      "  glint edges label part.obj -o part-open.ply --sampling vertices --cut-plane 0,0,1,0.1\n");
+  command->add_option("part", options->input, "STEP file (.step / .stp) or mesh (.obj / .ply)")
+      ->required();
   command->add_option("-o,--output", options->output, "Labelled PLY to write")
       ->required()
       ->check(kOutputFile);
@@ -82,15 +168,17 @@ void register_edges_label(CLI::App& edges) {
       ->add_option("--points", p.points,
                    "uniform / scan: points to draw; vertices: most points kept")
       ->capture_default_str();
-  command
-      ->add_option("--deflection", p.linear_deflection,
-                   "vertices: tessellation chord deflection, fraction of the bounding-box "
-                   "diagonal")
-      ->capture_default_str();
-  command
-      ->add_option("--angular-deflection", p.angular_deflection_deg,
-                   "vertices: tessellation angular deflection, degrees")
-      ->capture_default_str();
+  CLI::Option* deflection =
+      command
+          ->add_option("--deflection", p.linear_deflection,
+                       "STEP, vertices: tessellation chord deflection, fraction of the "
+                       "bounding-box diagonal")
+          ->capture_default_str();
+  CLI::Option* angular_deflection =
+      command
+          ->add_option("--angular-deflection", p.angular_deflection_deg,
+                       "STEP, vertices: tessellation angular deflection, degrees")
+          ->capture_default_str();
   command
       ->add_option("--plane-edge", p.plane_edge_fraction,
                    "vertices: split mesh edges longer than this fraction of the diagonal (0: "
@@ -113,8 +201,17 @@ void register_edges_label(CLI::App& edges) {
   command->add_option("--outliers", p.outlier_share, "Share of points displaced 2-15 spacings")
       ->capture_default_str();
   command->add_option("--seed", p.seed, "Seed of the sampling and noise")->capture_default_str();
+  command
+      ->add_option("--cut-plane", options->cut_plane,
+                   "NX,NY,NZ[,OFFSET]: keep the surface on the normal's side of the plane through "
+                   "the bounding box's centre moved OFFSET box diagonals along the normal")
+      ->delimiter(',')
+      ->expected(3, 4);
   command->add_option("--report", options->report, "JSON report (edge classes, label counts)");
-  command->callback([options] { run_label(*options); });
+  command->callback([options, deflection, angular_deflection] {
+    options->deflection_given = deflection->count() + angular_deflection->count() > 0;
+    run_label(*options);
+  });
 }
 
 }  // namespace glint::app

@@ -535,6 +535,15 @@ void check_part_params(const PartParams& p) {
   if (!(p.operation_time_limit_s > 0.0)) throw Error(where, "time_limit", "must be positive");
 }
 
+std::array<Eigen::Vector3d, 2> shape_bounds(const TopoDS_Shape& shape) {
+  Bnd_Box box;
+  BRepBndLib::Add(shape, box);
+  if (box.IsVoid() || box.IsOpen())
+    throw Error("shape", "bounding box", "is empty or unbounded (a face without a boundary)");
+  const Box b = bounding_box(shape);
+  return {Eigen::Vector3d(b.x0, b.y0, b.z0), Eigen::Vector3d(b.x1, b.y1, b.z1)};
+}
+
 TopoDS_Shape cut_open(const TopoDS_Shape& shape, const double point[3], const double normal[3]) {
   const std::lock_guard lock(modelling_mutex());
   try {

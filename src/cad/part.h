@@ -11,7 +11,9 @@
 // what was built. Same (params, index) -> same part on every run and thread count, unless an
 // operation hit the time limit (recorded as "timed_out" in the recipe). Thread-safe: the
 // kernel's modelling algorithms are not reentrant, so random_part and cut_open take turns.
+#include <Eigen/Core>
 #include <TopoDS_Shape.hxx>
+#include <array>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -55,5 +57,9 @@ Part random_part(const PartParams& params, std::uint64_t index);
 // `normal`, without a cap: the cut edges become open borders. Throws glint::Error when the
 // kernel fails or nothing remains.
 TopoDS_Shape cut_open(const TopoDS_Shape& shape, const double point[3], const double normal[3]);
+
+// The lowest and highest corners of the shape's axis-aligned bounding box. Throws
+// glint::Error("shape", "bounding box", ...) when the box is empty or unbounded.
+std::array<Eigen::Vector3d, 2> shape_bounds(const TopoDS_Shape& shape);
 
 }  // namespace glint::cad

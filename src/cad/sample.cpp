@@ -27,6 +27,7 @@
 #include <random>
 #include <unordered_map>
 
+#include "cad/surface_mesh.h"
 #include "core/error.h"
 #include "geometry/weld.h"
 
@@ -43,17 +44,12 @@ double uniform(Rng& rng, double low, double high) {
 
 Vec to_vec(const gp_Pnt& p) { return {p.X(), p.Y(), p.Z()}; }
 
-struct Mesh {
-  std::vector<Vec> vertices;
-  std::vector<std::array<int, 3>> triangles;  // wound along the outward face normal
-};
-
 // Triangulates every face with BRepMesh (single-threaded, so the result is reproducible).
-Mesh tessellate(const TopoDS_Shape& shape, double linear_deflection, double angular_rad) {
+SurfaceMesh tessellate(const TopoDS_Shape& shape, double linear_deflection, double angular_rad) {
   BRepTools::Clean(shape);
   BRepMesh_IncrementalMesh mesher(shape, linear_deflection, false, angular_rad, false);
   if (!mesher.IsDone()) throw Error("tessellation", "", "BRepMesh_IncrementalMesh failed");
-  Mesh mesh;
+  SurfaceMesh mesh;
   for (TopExp_Explorer it(shape, TopAbs_FACE); it.More(); it.Next()) {
     const TopoDS_Face face = TopoDS::Face(it.Current());
     TopLoc_Location location;
@@ -77,7 +73,7 @@ Mesh tessellate(const TopoDS_Shape& shape, double linear_deflection, double angu
 
 // Splits triangles at the midpoint of their longest edge until no edge exceeds max_edge
 // (a midpoint is shared by the triangles on both sides of its edge).
-void refine(Mesh& mesh, double max_edge) {
+void refine(SurfaceMesh& mesh, double max_edge) {
   std::unordered_map<std::uint64_t, int> midpoints;
   std::vector<std::array<int, 3>> done, todo = std::move(mesh.triangles);
   while (!todo.empty()) {
@@ -103,18 +99,6 @@ void refine(Mesh& mesh, double max_edge) {
   mesh.triangles = std::move(done);
 }
 
-Vec triangle_normal(const Mesh& mesh, const std::array<int, 3>& t) {
-  const Vec& a = mesh.vertices[t[0]];
-  const Vec n = (mesh.vertices[t[1]] - a).cross(mesh.vertices[t[2]] - a);
-  const double length = n.norm();
-  return length > 0 ? Vec(n / length) : Vec(0, 0, 1);
-}
-
-double triangle_area(const Mesh& mesh, const std::array<int, 3>& t) {
-  const Vec& a = mesh.vertices[t[0]];
-  return 0.5 * (mesh.vertices[t[1]] - a).cross(mesh.vertices[t[2]] - a).norm();
-}
-
 struct Samples {
   std::vector<Vec> positions, normals;
   std::vector<double> spacing;         // local spacing at each sample
@@ -125,7 +109,7 @@ struct Samples {
 // Area-weighted random points on the triangles (normals are the triangles').
 class SurfaceSampler {
  public:
-  explicit SurfaceSampler(const Mesh& mesh) : mesh_(mesh) {
+  explicit SurfaceSampler(const SurfaceMesh& mesh) : mesh_(mesh) {
     for (const auto& t : mesh.triangles) {
       area_ += triangle_area(mesh, t);
       cumulative_.push_back(area_);
@@ -146,15 +130,13 @@ class SurfaceSampler {
   }
 
  private:
-  const Mesh& mesh_;
+  const SurfaceMesh& mesh_;
   std::vector<double> cumulative_;
   double area_ = 0.0;
 };
 
-Samples sample_vertices(const TopoDS_Shape& shape, const SampleParams& p, double diagonal,
-                        Rng& rng) {
-  Mesh mesh =
-      tessellate(shape, p.linear_deflection * diagonal, p.angular_deflection_deg * kPi / 180.0);
+// The mesh's own vertices (welded; long edges split when plane_edge_fraction asks).
+Samples sample_vertices(SurfaceMesh mesh, const SampleParams& p, double diagonal, Rng& rng) {
   geometry::weld_vertices(mesh, 1e-7 * diagonal);
   if (p.plane_edge_fraction > 0.0) refine(mesh, p.plane_edge_fraction * diagonal);
   const std::size_t n = mesh.vertices.size();
@@ -184,22 +166,18 @@ Samples sample_vertices(const TopoDS_Shape& shape, const SampleParams& p, double
     s.normals.push_back(normals[i].norm() > 0 ? Vec(normals[i].normalized()) : Vec(0, 0, 1));
     s.spacing.push_back(edge_sum[i] / edge_count[i]);
   }
-  s.description = {{"linear_deflection", p.linear_deflection},
-                   {"angular_deflection_degrees", p.angular_deflection_deg},
-                   {"plane_edge_fraction", p.plane_edge_fraction},
+  s.description = {{"plane_edge_fraction", p.plane_edge_fraction},
                    {"mesh_vertices", n},
                    {"mesh_triangles", mesh.triangles.size()}};
   return s;
 }
 
 // A fine tessellation for uniform and scan sampling: chord error far below a point spacing.
-Mesh fine_mesh(const TopoDS_Shape& shape, double diagonal) {
+SurfaceMesh fine_mesh(const TopoDS_Shape& shape, double diagonal) {
   return tessellate(shape, 2e-4 * diagonal, 8.0 * kPi / 180.0);
 }
 
-Samples sample_uniform(const TopoDS_Shape& shape, const SampleParams& p, double diagonal,
-                       Rng& rng) {
-  const Mesh mesh = fine_mesh(shape, diagonal);
+Samples sample_uniform(const SurfaceMesh& mesh, const SampleParams& p, Rng& rng) {
   const SurfaceSampler sampler(mesh);
   const double spacing = std::sqrt(sampler.area() / p.points);
   Samples s;
@@ -211,11 +189,11 @@ Samples sample_uniform(const TopoDS_Shape& shape, const SampleParams& p, double 
   return s;
 }
 
-// ---- scan sampling (Embree ray casts on the fine tessellation).
+// ---- scan sampling (Embree ray casts on the fine tessellation or the mesh).
 
 class RayCaster {
  public:
-  explicit RayCaster(const Mesh& mesh) {
+  explicit RayCaster(const SurfaceMesh& mesh) {
     device_ = rtcNewDevice("threads=1");
     scene_ = rtcNewScene(device_);
     RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -274,9 +252,8 @@ struct Viewpoint {
 // Scanners drop returns beyond ~84 degrees of incidence.
 constexpr double kMinIncidenceCos = 0.1;
 
-Samples sample_scan(const TopoDS_Shape& shape, const SampleParams& p, const Vec& centre,
+Samples sample_scan(const SurfaceMesh& mesh, const SampleParams& p, const Vec& centre,
                     double diagonal, Rng& rng) {
-  const Mesh mesh = fine_mesh(shape, diagonal);
   const RayCaster caster(mesh);
   const int views = std::uniform_int_distribution<int>(1, p.viewpoints)(rng);
   std::vector<Viewpoint> viewpoints;
@@ -394,6 +371,74 @@ Samples sample_scan(const TopoDS_Shape& shape, const SampleParams& p, const Vec&
   return s;
 }
 
+// Noise, outliers and labels from the feature curves (the rule of sample.h), shared by B-rep
+// parts and meshes. `edge_source` names the curves' origin in the description.
+LabelledCloud label_samples(const Samples& samples, const EdgeClasses& classes,
+                            const SampleParams& params, const Vec& centre, double diagonal,
+                            const std::string& edge_source, Rng& rng) {
+  const std::size_t n = samples.positions.size();
+  if (n == 0) throw Error("shape", "sampling", "gave no points");
+  std::vector<double> sorted = samples.spacing;
+  std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
+  const double median_spacing = sorted[n / 2];
+  const double largest_spacing = *std::max_element(samples.spacing.begin(), samples.spacing.end());
+  const edges::FeatureIndex features(classes.segments,
+                                     std::max(params.band, params.boundary_band) * largest_spacing);
+
+  std::normal_distribution<double> normal_draw;
+  PointCloud cloud;
+  cloud.reserve(n);
+  std::vector<std::uint8_t> labels(n);
+  std::size_t counts[3] = {0, 0, 0}, outliers = 0;
+  const double scale = params.normalise ? 1.0 / diagonal : 1.0;
+  const Vec origin = params.normalise ? centre : Vec::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec p = samples.positions[i];
+    const double local = samples.spacing[i];
+    auto label_at = [&](const Vec& q) {
+      return features.label(q, params.band * local, params.boundary_band * local);
+    };
+    std::uint8_t label = label_at(p);
+    if (!samples.not_seen.empty() && samples.not_seen[i]) label = edges::kLabelBoundary;
+    if (params.noise > 0.0)
+      p += params.noise * median_spacing * normal_draw(rng) * samples.normals[i];
+    if (params.outlier_share > 0.0 && uniform(rng, 0.0, 1.0) < params.outlier_share) {
+      const Vec direction = Vec(normal_draw(rng), normal_draw(rng), normal_draw(rng)).normalized();
+      p += uniform(rng, 2.0, 15.0) * median_spacing * direction;
+      label = label_at(p);
+      ++outliers;
+    }
+    p = (p - origin) * scale;
+    cloud.push_back(float(p.x()), float(p.y()), float(p.z()));
+    labels[i] = label;
+    ++counts[label];
+  }
+  cloud.set("label", std::move(labels));
+
+  LabelledCloud result;
+  result.cloud = std::move(cloud);
+  result.description = {
+      {"sampling", sampling_names()[static_cast<std::size_t>(params.sampling)]},
+      {"sampling_details", samples.description},
+      {"points", n},
+      {"median_spacing", median_spacing * scale},
+      {"diagonal", diagonal * scale},
+      {"normalised", params.normalise},
+      {"noise_spacings", params.noise},
+      {"outliers", outliers},
+      {"band_spacings", params.band},
+      {"boundary_band_spacings", params.boundary_band},
+      {"sharp_angle_degrees", params.sharp_angle_deg},
+      {edge_source,
+       {{"sharp", classes.sharp},
+        {"smooth", classes.smooth},
+        {"boundary", classes.boundary},
+        {"sharp_length", classes.sharp_length * scale},
+        {"boundary_length", classes.boundary_length * scale}}},
+      {"labels", {{"non-edge", counts[0]}, {"sharp-edge", counts[1]}, {"boundary", counts[2]}}}};
+  return result;
+}
+
 }  // namespace
 
 const std::vector<std::string>& sampling_names() {
@@ -462,6 +507,18 @@ std::uint8_t classify_edge(const TopoDS_Edge& edge, const TopTools_ListOfShape& 
   return largest >= sharp_angle_deg * kPi / 180.0 ? edges::kLabelSharp : 0;
 }
 
+void EdgeClasses::count(std::uint8_t label, double length) {
+  if (label == edges::kLabelSharp) {
+    ++sharp;
+    sharp_length += length;
+  } else if (label == edges::kLabelBoundary) {
+    ++boundary;
+    boundary_length += length;
+  } else {
+    ++smooth;
+  }
+}
+
 EdgeClasses classify_edges(const TopoDS_Shape& shape, double sharp_angle_deg,
                            double polyline_tolerance) {
   EdgeClasses classes;
@@ -480,15 +537,7 @@ EdgeClasses classify_edges(const TopoDS_Shape& shape, double sharp_angle_deg,
       length += (b - a).norm();
       if (label) classes.segments.push_back({a, b, label});
     }
-    if (label == edges::kLabelSharp) {
-      ++classes.sharp;
-      classes.sharp_length += length;
-    } else if (label == edges::kLabelBoundary) {
-      ++classes.boundary;
-      classes.boundary_length += length;
-    } else {
-      ++classes.smooth;
-    }
+    classes.count(label, length);
   }
   return classes;
 }
@@ -516,80 +565,54 @@ LabelledCloud sample_shape(const TopoDS_Shape& shape, const SampleParams& params
     classes = classify_edges(shape, params.sharp_angle_deg, 1e-4 * diagonal);
     switch (params.sampling) {
       case Sampling::vertices:
-        samples = sample_vertices(shape, params, diagonal, rng);
+        samples = sample_vertices(tessellate(shape, params.linear_deflection * diagonal,
+                                             params.angular_deflection_deg * kPi / 180.0),
+                                  params, diagonal, rng);
+        samples.description["linear_deflection"] = params.linear_deflection;
+        samples.description["angular_deflection_degrees"] = params.angular_deflection_deg;
         break;
       case Sampling::uniform:
-        samples = sample_uniform(shape, params, diagonal, rng);
+        samples = sample_uniform(fine_mesh(shape, diagonal), params, rng);
         break;
       case Sampling::scan:
-        samples = sample_scan(shape, params, centre, diagonal, rng);
+        samples = sample_scan(fine_mesh(shape, diagonal), params, centre, diagonal, rng);
         break;
     }
   } catch (const Standard_Failure& e) {
     throw Error("shape", "", std::string("kernel: ") + e.GetMessageString());
   }
+  return label_samples(samples, classes, params, centre, diagonal, "brep_edges", rng);
+}
 
-  const std::size_t n = samples.positions.size();
-  if (n == 0) throw Error("shape", "sampling", "gave no points");
-  std::vector<double> sorted = samples.spacing;
-  std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
-  const double median_spacing = sorted[n / 2];
-  const double largest_spacing = *std::max_element(samples.spacing.begin(), samples.spacing.end());
-  const edges::FeatureIndex features(classes.segments,
-                                     std::max(params.band, params.boundary_band) * largest_spacing);
-
-  std::normal_distribution<double> normal_draw;
-  PointCloud cloud;
-  cloud.reserve(n);
-  std::vector<std::uint8_t> labels(n);
-  std::size_t counts[3] = {0, 0, 0}, outliers = 0;
-  const double scale = params.normalise ? 1.0 / diagonal : 1.0;
-  const Vec origin = params.normalise ? centre : Vec::Zero();
-  for (std::size_t i = 0; i < n; ++i) {
-    Vec p = samples.positions[i];
-    const double local = samples.spacing[i];
-    auto label_at = [&](const Vec& q) {
-      return features.label(q, params.band * local, params.boundary_band * local);
-    };
-    std::uint8_t label = label_at(p);
-    if (!samples.not_seen.empty() && samples.not_seen[i]) label = edges::kLabelBoundary;
-    if (params.noise > 0.0)
-      p += params.noise * median_spacing * normal_draw(rng) * samples.normals[i];
-    if (params.outlier_share > 0.0 && uniform(rng, 0.0, 1.0) < params.outlier_share) {
-      const Vec direction = Vec(normal_draw(rng), normal_draw(rng), normal_draw(rng)).normalized();
-      p += uniform(rng, 2.0, 15.0) * median_spacing * direction;
-      label = label_at(p);
-      ++outliers;
-    }
-    p = (p - origin) * scale;
-    cloud.push_back(float(p.x()), float(p.y()), float(p.z()));
-    labels[i] = label;
-    ++counts[label];
+LabelledCloud sample_mesh(SurfaceMesh mesh, const SampleParams& params, const std::string& name) {
+  check_sample_params(params);
+  if (mesh.triangles.empty()) throw Error(name, "", "has no triangles to sample");
+  Vec low = mesh.vertices.front(), high = low;
+  for (const Vec& v : mesh.vertices) low = low.cwiseMin(v), high = high.cwiseMax(v);
+  const Vec centre = 0.5 * (low + high);
+  const double diagonal = (high - low).norm();
+  if (!(diagonal > 0) || !std::isfinite(diagonal))
+    throw Error(name, "vertices", "span no extent or are not finite");
+  // Copies of a vertex (an OBJ's seams, an STL's unshared corners) would split every edge.
+  geometry::weld_vertices(mesh, 1e-7 * diagonal);
+  double area = 0.0;
+  for (const auto& t : mesh.triangles) area += triangle_area(mesh, t);
+  if (!(area > 0)) throw Error(name, "triangles", "are all degenerate (the surface has no area)");
+  const EdgeClasses classes = classify_mesh_edges(mesh, params.sharp_angle_deg);
+  Rng rng(params.seed);
+  Samples samples;
+  switch (params.sampling) {
+    case Sampling::vertices:
+      samples = sample_vertices(mesh, params, diagonal, rng);
+      break;
+    case Sampling::uniform:
+      samples = sample_uniform(mesh, params, rng);
+      break;
+    case Sampling::scan:
+      samples = sample_scan(mesh, params, centre, diagonal, rng);
+      break;
   }
-  cloud.set("label", std::move(labels));
-
-  LabelledCloud result;
-  result.cloud = std::move(cloud);
-  result.description = {
-      {"sampling", sampling_names()[static_cast<std::size_t>(params.sampling)]},
-      {"sampling_details", samples.description},
-      {"points", n},
-      {"median_spacing", median_spacing * scale},
-      {"diagonal", diagonal * scale},
-      {"normalised", params.normalise},
-      {"noise_spacings", params.noise},
-      {"outliers", outliers},
-      {"band_spacings", params.band},
-      {"boundary_band_spacings", params.boundary_band},
-      {"sharp_angle_degrees", params.sharp_angle_deg},
-      {"brep_edges",
-       {{"sharp", classes.sharp},
-        {"smooth", classes.smooth},
-        {"boundary", classes.boundary},
-        {"sharp_length", classes.sharp_length * scale},
-        {"boundary_length", classes.boundary_length * scale}}},
-      {"labels", {{"non-edge", counts[0]}, {"sharp-edge", counts[1]}, {"boundary", counts[2]}}}};
-  return result;
+  return label_samples(samples, classes, params, centre, diagonal, "mesh_edges", rng);
 }
 
 }  // namespace glint::cad

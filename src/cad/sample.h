@@ -1,6 +1,6 @@
 #pragma once
-// Labelled point clouds from a B-rep (OpenCASCADE shape): the labels come from the B-rep's
-// edges, never from the samples.
+// Labelled point clouds from a B-rep (OpenCASCADE shape) or a triangle mesh: the labels come
+// from the B-rep's edges (or the mesh's, surface_mesh.h), never from the samples.
 //
 // Edge classes (classify_edges): an edge with one adjacent face is an open border (boundary);
 // one with two faces is sharp when the faces' normals, sampled at 9 points along the edge, turn
@@ -16,9 +16,10 @@
 //
 // Samplings:
 //   vertices  the nodes of BRepMesh_IncrementalMesh's tessellation (as ABC and PCEDNet clouds
-//             are): dense along curved faces and feature curves, sparse on planes (their large
-//             triangles may be split down to plane_edge_fraction of the diagonal); local
-//             spacing = mean length of a vertex's mesh edges;
+//             are), or a mesh's own vertices: dense along curved faces and feature curves,
+//             sparse on planes (their large triangles may be split down to
+//             plane_edge_fraction of the diagonal); local spacing = mean length of a vertex's
+//             mesh edges;
 //   uniform   uniform random on the surface, spacing sqrt(area / points);
 //   scan      rays from 1..viewpoints scanner positions in scan-line patterns (rows coarser than
 //             the points along a row), density falling with range, occlusion holes, grazing
@@ -33,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "cad/surface_mesh.h"
 #include "core/point_cloud.h"
 #include "edges/feature_index.h"
 
@@ -47,6 +49,9 @@ struct EdgeClasses {
   std::vector<edges::FeatureSegment> segments;  // sharp and boundary edges as polylines
   int sharp = 0, smooth = 0, boundary = 0;      // B-rep edge counts
   double sharp_length = 0.0, boundary_length = 0.0;
+
+  // One more edge of the class (0 smooth) and `length`.
+  void count(std::uint8_t label, double length);
 };
 
 // One edge's class given its (unique) adjacent faces: 0 smooth, edges::kLabelSharp,
@@ -87,5 +92,10 @@ struct LabelledCloud {
 // Tessellates (replacing any triangulation the shape holds), samples and labels. Throws
 // glint::Error when the shape has no faces or the kernel cannot tessellate it.
 LabelledCloud sample_shape(const TopoDS_Shape& shape, const SampleParams& params);
+
+// A triangle mesh (shape units) welded, sampled and labelled from its own edges
+// (classify_mesh_edges); the deflections do not apply. "mesh_edges" in the description counts
+// the edge classes. Throws glint::Error(name, ...) when the mesh has no triangles or no extent.
+LabelledCloud sample_mesh(SurfaceMesh mesh, const SampleParams& params, const std::string& name);
 
 }  // namespace glint::cad

@@ -2,6 +2,7 @@
 // one-line error.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -42,6 +43,66 @@ TEST_F(CliTest, LabelNamesABadStepFileInOneLine) {
   EXPECT_EQ(label.exit_code, 1);
   EXPECT_NE(label.output.find("bad.step"), std::string::npos) << label.output;
   EXPECT_EQ(std::count(label.output.begin(), label.output.end(), '\n'), 1) << label.output;
+  EXPECT_FALSE(fs::exists(path("out.ply")));
+}
+
+// The unit cube as an OBJ: 8 corners, 12 triangles.
+void write_cube_obj(const std::string& file) {
+  std::ofstream obj(file);
+  for (int i = 0; i < 8; ++i)
+    obj << "v " << (i & 1) << ' ' << ((i >> 1) & 1) << ' ' << (i >> 2) << '\n';
+  obj << "f 1 3 4\nf 1 4 2\nf 5 6 8\nf 5 8 7\nf 1 2 6\nf 1 6 5\n"
+         "f 3 7 8\nf 3 8 4\nf 1 5 7\nf 1 7 3\nf 2 4 8\nf 2 8 6\n";
+}
+
+TEST_F(CliTest, LabelAMeshAtItsVerticesAndCutOpen) {
+  write_cube_obj(path("cube.obj"));
+  const CommandResult closed =
+      glint("edges label " + path("cube.obj") + " -o " + path("cube.ply") + " --sampling vertices");
+  ASSERT_EQ(closed.exit_code, 0) << closed.output;
+  const PointCloud corners = io::read_ply(path("cube.ply"));
+  ASSERT_EQ(corners.size(), 8u);
+  for (std::uint8_t label : *corners.get<std::uint8_t>("label")) EXPECT_EQ(label, 1);
+
+  const CommandResult cut =
+      glint("edges label " + path("cube.obj") + " -o " + path("cut.ply") +
+            " --points 4000 --cut-plane 0,0,1,0.1 --report " + path("cut.json"));
+  ASSERT_EQ(cut.exit_code, 0) << cut.output;
+  const auto report = nlohmann::json::parse(std::ifstream(path("cut.json")));
+  // The plane z = 0.5 + 0.1 * sqrt(3) keeps the top; the cut is the four sides' border.
+  EXPECT_NEAR(report["cut_plane"]["point"][2].get<double>(), 0.5 + 0.1 * std::sqrt(3.0), 1e-12);
+  EXPECT_NEAR(report["cloud"]["mesh_edges"]["boundary_length"].get<double>(), 4.0, 1e-9);
+  const PointCloud cloud = io::read_ply(path("cut.ply"));
+  const auto& labels = *cloud.get<std::uint8_t>("label");
+  int boundary = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    EXPECT_GE(cloud.point(i).z(), 0.5f + 0.1f * std::sqrt(3.0f) - 1e-5f);
+    if (labels[i] == 2) {
+      ++boundary;
+      EXPECT_LT(cloud.point(i).z(), 0.5f + 0.1f * std::sqrt(3.0f) + 0.05f);
+    }
+  }
+  EXPECT_GT(boundary, 0);
+}
+
+TEST_F(CliTest, LabelRefusesWhatAMeshCannotGiveInOneLine) {
+  write_cube_obj(path("cube.obj"));
+  for (const std::string& arguments :
+       {std::string(" --deflection 0.01"), std::string(" --cut-plane 0,0,1,2"),
+        std::string(" --cut-plane 0,0,0")}) {
+    const CommandResult label =
+        glint("edges label " + path("cube.obj") + " -o " + path("out.ply") + arguments);
+    EXPECT_EQ(label.exit_code, 1) << arguments;
+    EXPECT_EQ(std::count(label.output.begin(), label.output.end(), '\n'), 1) << label.output;
+    EXPECT_FALSE(fs::exists(path("out.ply")));
+  }
+  // A point cloud has no surface to label.
+  PointCloud points;
+  points.push_back(0, 0, 0);
+  io::write_ply(path("points.ply"), points);
+  const CommandResult label = glint("edges label " + path("points.ply") + " -o " + path("out.ply"));
+  EXPECT_EQ(label.exit_code, 1);
+  EXPECT_NE(label.output.find("points.ply"), std::string::npos) << label.output;
   EXPECT_FALSE(fs::exists(path("out.ply")));
 }
 

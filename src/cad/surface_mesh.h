@@ -1,0 +1,38 @@
+#pragma once
+// Triangle meshes as the labeller samples them: a CAD kernel's tessellation of a B-rep, or a
+// user's own mesh (an ABC-style OBJ, a scan's reconstruction). For a user's mesh the feature
+// curves come from the mesh itself: its edges are classified by the turn of the normals of the
+// triangles beside them, the rule classify_edge applies to a B-rep edge's two faces.
+#include <Eigen/Core>
+#include <array>
+#include <vector>
+
+namespace glint::cad {
+
+struct EdgeClasses;
+
+struct SurfaceMesh {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<std::array<int, 3>> triangles;  // counter-clockwise seen from outside, if known
+};
+
+// Unit normal of a triangle by its winding ((0, 0, 1) for a degenerate one) and its area.
+Eigen::Vector3d triangle_normal(const SurfaceMesh& mesh, const std::array<int, 3>& t);
+double triangle_area(const SurfaceMesh& mesh, const std::array<int, 3>& t);
+
+// Every mesh edge classified from the non-degenerate triangles beside it: one is an open border
+// (boundary); two are sharp when their normals turn by at least sharp_angle_deg (a pair that
+// runs the edge the same way is wound inconsistently and is compared with one normal flipped);
+// more than two (non-manifold) is sharp. An edge beside a degenerate triangle is not a feature.
+// Smooth edges are counted, not kept. Call on a welded mesh: copies of a vertex split edges.
+EdgeClasses classify_mesh_edges(const SurfaceMesh& mesh, double sharp_angle_deg);
+
+// The part of the surface on the positive side of the plane through `point` with normal
+// `normal` (a vertex on the plane is kept), without a cap: the triangles the plane crosses are
+// clipped at it, so the cut is a run of mesh edges with one triangle, an open border. Vertices
+// no kept triangle uses are dropped. Throws glint::Error("--cut-plane", ...) when nothing of the
+// mesh lies on the kept side or the normal is zero.
+SurfaceMesh cut_mesh(const SurfaceMesh& mesh, const Eigen::Vector3d& point,
+                     const Eigen::Vector3d& normal);
+
+}  // namespace glint::cad
