@@ -11,7 +11,8 @@
 # - Boundaries: fandisk and rocker-arm (its smooth tessellation has no such gap, so it is not
 #   scored for sharp edges), each cut open by the eight planes below (unit normals and offsets in
 #   box diagonals, drawn once from a seeded generator), at mesh vertices and uniformly, clean and
-#   at noise 0.5.
+#   at noise 0.5; at clean mesh vertices also with the crossed triangles dropped (--cut-mode
+#   drop) instead of clipped.
 # The shipped models are scored beside CA and the angle-gap criterion (its default, and 4
 # spacings with k = 64 on the uniform clouds). Nothing here chose a model or a setting.
 set -euo pipefail
@@ -73,6 +74,18 @@ for sampling in vertices uniform; do
     fi
   done
 done
+
+# The same cuts with the crossed triangles dropped (a jagged border), clean mesh vertices.
+set_dir="$WORK/boundary-drop-vertices-noise0"
+mkdir -p "$set_dir"
+for mesh in fandisk rocker-arm; do
+  for k in "${!PLANES[@]}"; do
+    label "$mesh" "$set_dir/$mesh-cut$k.ply" --sampling vertices --cut-plane "${PLANES[$k]}" \
+      --cut-mode drop
+  done
+done
+evaluate "$set_dir" boundary "$WORK/boundary-drop-vertices-noise0.json" \
+  --model models/bounded-3c.json
 
 # One row per set and method: median MCC over the files (range).
 /usr/bin/python3 - "$WORK" <<'EOF'

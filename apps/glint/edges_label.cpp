@@ -27,7 +27,9 @@ struct LabelOptions {
   std::string sampling = "uniform";
   std::string report;
   std::vector<double> cut_plane;  // normal x, y, z and an optional offset in diagonals
+  std::string cut_mode = "clip";
   bool deflection_given = false;
+  bool cut_mode_given = false;
   cad::SampleParams params;
 };
 
@@ -70,17 +72,22 @@ cad::LabelledCloud label_mesh(const LabelOptions& options, nlohmann::json& cut) 
     for (const Eigen::Vector3d& v : mesh.vertices) low = low.cwiseMin(v), high = high.cwiseMax(v);
     const CutPlane plane = cut_plane(options.cut_plane, low, high);
     try {
-      mesh = cad::cut_mesh(mesh, plane.point, plane.normal);
+      mesh = cad::cut_mesh(mesh, plane.point, plane.normal,
+                           options.cut_mode == "drop" ? cad::CutMode::drop : cad::CutMode::clip);
     } catch (const Error& e) {
       throw Error(options.input, "--cut-plane", e.reason());
     }
     cut = {{"point", {plane.point.x(), plane.point.y(), plane.point.z()}},
-           {"normal", {plane.normal.x(), plane.normal.y(), plane.normal.z()}}};
+           {"normal", {plane.normal.x(), plane.normal.y(), plane.normal.z()}},
+           {"mode", options.cut_mode}};
   }
   return cad::sample_mesh(std::move(mesh), options.params, options.input);
 }
 
 cad::LabelledCloud label_step(const LabelOptions& options, nlohmann::json& cut) {
+  if (options.cut_mode_given)
+    throw Error(options.input, "--cut-mode",
+                "applies to meshes; a STEP part is cut on its B-rep, where the cut is exact");
   TopoDS_Shape shape = cad::read_step(options.input);
   if (!options.cut_plane.empty()) {
     const auto [low, high] = cad::shape_bounds(shape);
@@ -207,9 +214,17 @@ void register_edges_label(CLI::App& edges) {
                    "the bounding box's centre moved OFFSET box diagonals along the normal")
       ->delimiter(',')
       ->expected(3, 4);
+  CLI::Option* cut_mode =
+      command
+          ->add_option("--cut-mode", options->cut_mode,
+                       "mesh: 'clip' the triangles the plane crosses at the plane, or 'drop' them "
+                       "(a jagged border, as deleting the points on one side leaves)")
+          ->check(CLI::IsMember({"clip", "drop"}))
+          ->capture_default_str();
   command->add_option("--report", options->report, "JSON report (edge classes, label counts)");
-  command->callback([options, deflection, angular_deflection] {
+  command->callback([options, deflection, angular_deflection, cut_mode] {
     options->deflection_given = deflection->count() + angular_deflection->count() > 0;
+    options->cut_mode_given = cut_mode->count() > 0;
     run_label(*options);
   });
 }

@@ -81,7 +81,7 @@ EdgeClasses classify_mesh_edges(const SurfaceMesh& mesh, double sharp_angle_deg)
   return classes;
 }
 
-SurfaceMesh cut_mesh(const SurfaceMesh& mesh, const Vec& point, const Vec& normal) {
+SurfaceMesh cut_mesh(const SurfaceMesh& mesh, const Vec& point, const Vec& normal, CutMode mode) {
   if (!(normal.norm() > 0)) throw Error("--cut-plane", "normal", "is zero");
   const Vec n = normal.normalized();
   std::vector<double> height(mesh.vertices.size());
@@ -109,6 +109,8 @@ SurfaceMesh cut_mesh(const SurfaceMesh& mesh, const Vec& point, const Vec& norma
     return it->second;
   };
   for (const auto& t : mesh.triangles) {
+    if (mode == CutMode::drop && !(height[t[0]] >= 0 && height[t[1]] >= 0 && height[t[2]] >= 0))
+      continue;
     // The triangle clipped to the kept side (Sutherland-Hodgman against one plane): at most
     // four corners, in the triangle's winding.
     std::array<int, 4> polygon{};

@@ -27,12 +27,17 @@ double triangle_area(const SurfaceMesh& mesh, const std::array<int, 3>& t);
 // Smooth edges are counted, not kept. Call on a welded mesh: copies of a vertex split edges.
 EdgeClasses classify_mesh_edges(const SurfaceMesh& mesh, double sharp_angle_deg);
 
+// How a cut treats the triangles the plane crosses: clip them at the plane (the cut is a
+// straight run of new mesh edges) or drop them whole (the border is jagged, one triangle wide,
+// as when the points on one side of a plane are deleted).
+enum class CutMode { clip, drop };
+
 // The part of the surface on the positive side of the plane through `point` with normal
-// `normal` (a vertex on the plane is kept), without a cap: the triangles the plane crosses are
-// clipped at it, so the cut is a run of mesh edges with one triangle, an open border. Vertices
-// no kept triangle uses are dropped. Throws glint::Error("--cut-plane", ...) when nothing of the
-// mesh lies on the kept side or the normal is zero.
+// `normal` (a vertex on the plane is kept), without a cap: the border the cut leaves is a run
+// of mesh edges with one triangle, an open border. Vertices no kept triangle uses are dropped.
+// Throws glint::Error("--cut-plane", ...) when nothing of the mesh lies on the kept side or
+// the normal is zero.
 SurfaceMesh cut_mesh(const SurfaceMesh& mesh, const Eigen::Vector3d& point,
-                     const Eigen::Vector3d& normal);
+                     const Eigen::Vector3d& normal, CutMode mode = CutMode::clip);
 
 }  // namespace glint::cad

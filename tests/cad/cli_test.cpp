@@ -35,6 +35,19 @@ TEST_F(CliTest, CadSynthThenLabelAStepPart) {
   ASSERT_TRUE(cloud.get<std::uint8_t>("label"));
   const auto report = nlohmann::json::parse(std::ifstream(path("label.json")));
   EXPECT_GT(report["cloud"]["labels"]["sharp-edge"].get<int>(), 0);
+
+  // Cut open on the B-rep: the cut is a boundary; the mesh-only --cut-mode is refused.
+  const CommandResult cut = glint("edges label " + path("part.step") + " -o " + path("cut.ply") +
+                                  " --points 3000 --cut-plane 0,0,1 --report " + path("cut.json"));
+  ASSERT_EQ(cut.exit_code, 0) << cut.output;
+  const auto cut_report = nlohmann::json::parse(std::ifstream(path("cut.json")));
+  EXPECT_GT(cut_report["cloud"]["brep_edges"]["boundary"].get<int>(), 0);
+  EXPECT_GT(cut_report["cloud"]["labels"]["boundary"].get<int>(), 0);
+  const CommandResult refused = glint("edges label " + path("part.step") + " -o " +
+                                      path("drop.ply") + " --cut-plane 0,0,1 --cut-mode drop");
+  EXPECT_EQ(refused.exit_code, 1) << refused.output;
+  EXPECT_NE(refused.output.find("--cut-mode"), std::string::npos) << refused.output;
+  EXPECT_FALSE(fs::exists(path("drop.ply")));
 }
 
 TEST_F(CliTest, LabelNamesABadStepFileInOneLine) {

@@ -1,6 +1,7 @@
 // A mesh's own edges as ground truth: a cube's edges are sharp and its face diagonals smooth
 // (whatever the winding), a finely tessellated cylinder's rims are sharp and its side smooth,
-// and a plane cut leaves a boundary on the cut only.
+// and a plane cut leaves a boundary on the cut only, clipped or with the crossed triangles
+// dropped.
 #include "cad/surface_mesh.h"
 
 #include <gtest/gtest.h>
@@ -86,6 +87,21 @@ TEST(SurfaceMesh, ACutCylinderHasItsBoundaryOnTheCutOnly) {
     EXPECT_NEAR(segment.b.z(), cut_height, 1e-12);
   }
   for (const Vec& v : cut.vertices) EXPECT_GE(v.z(), cut_height - 1e-12);
+}
+
+TEST(SurfaceMesh, ADropCutEndsAtTheLastWholeTriangles) {
+  // The side's rings lie at z = 0, 0.5, ..., 2: dropping every triangle with a corner below 0.7
+  // leaves the border on the ring at 1.
+  const SurfaceMesh cut = cut_mesh(cylinder(64, 4), Vec(0, 0, 0.7), Vec(0, 0, 1), CutMode::drop);
+  const EdgeClasses classes = classify_mesh_edges(cut, 25.0);
+  EXPECT_EQ(classes.boundary, 64);
+  EXPECT_EQ(classes.sharp, 64);
+  for (const auto& segment : classes.segments) {
+    if (segment.label == edges::kLabelBoundary) {
+      EXPECT_NEAR(segment.a.z(), 1.0, 1e-12);
+    }
+  }
+  EXPECT_EQ(cut.vertices.size(), 3u * 64u + 1u);  // three rings and the top centre
 }
 
 TEST(SurfaceMesh, ACutThatKeepsNothingFails) {
