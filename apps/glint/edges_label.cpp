@@ -33,11 +33,14 @@ struct LabelOptions {
   cad::SampleParams params;
 };
 
+// Whether the input is a STEP part (else a mesh); throws for any other extension.
 bool is_step(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return char(std::tolower(c)); });
-  return extension == ".step" || extension == ".stp";
+  if (extension == ".step" || extension == ".stp") return true;
+  if (extension == ".obj" || extension == ".ply") return false;
+  throw Error(path, "", "unknown format (expected .step, .stp, .obj or .ply)");
 }
 
 // The plane of --cut-plane: through the bounding box's centre moved `offset` diagonals along

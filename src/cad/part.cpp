@@ -540,8 +540,9 @@ std::array<Eigen::Vector3d, 2> shape_bounds(const TopoDS_Shape& shape) {
   BRepBndLib::Add(shape, box);
   if (box.IsVoid() || box.IsOpen())
     throw Error("shape", "bounding box", "is empty or unbounded (a face without a boundary)");
-  const Box b = bounding_box(shape);
-  return {Eigen::Vector3d(b.x0, b.y0, b.z0), Eigen::Vector3d(b.x1, b.y1, b.z1)};
+  double x0, y0, z0, x1, y1, z1;
+  box.Get(x0, y0, z0, x1, y1, z1);
+  return {Eigen::Vector3d(x0, y0, z0), Eigen::Vector3d(x1, y1, z1)};
 }
 
 TopoDS_Shape cut_open(const TopoDS_Shape& shape, const double point[3], const double normal[3]) {

@@ -109,6 +109,11 @@ TEST_F(CliTest, LabelRefusesWhatAMeshCannotGiveInOneLine) {
     EXPECT_EQ(std::count(label.output.begin(), label.output.end(), '\n'), 1) << label.output;
     EXPECT_FALSE(fs::exists(path("out.ply")));
   }
+  // Neither a part nor a mesh.
+  std::ofstream(path("part.stl")) << "solid part\nendsolid part\n";
+  const CommandResult stl = glint("edges label " + path("part.stl") + " -o " + path("out.ply"));
+  EXPECT_EQ(stl.exit_code, 1);
+  EXPECT_NE(stl.output.find(".step, .stp, .obj or .ply"), std::string::npos) << stl.output;
   // A point cloud has no surface to label.
   PointCloud points;
   points.push_back(0, 0, 0);
