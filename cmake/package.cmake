@@ -44,6 +44,6 @@ set(glint_dev_depends
     " libfmt-dev, libspdlog-dev, libopencv-dev, libpng-dev, libembree-dev, libtinyobjloader-dev,"
     " libmeshoptimizer-dev,"
     " libocct-foundation-dev, libocct-modeling-data-dev, libocct-modeling-algorithms-dev,"
-    " libocct-data-exchange-dev")
+    " libocct-data-exchange-dev, libyaml-cpp-dev")
 string(JOIN "" CPACK_DEBIAN_DEVELOPMENT_PACKAGE_DEPENDS ${glint_dev_depends})
 include(CPack)

@@ -25,6 +25,8 @@ packages=(
   # OpenCASCADE: CAD-kernel training data and STEP input for BoundED (src/cad).
   libocct-foundation-dev libocct-modeling-data-dev libocct-modeling-algorithms-dev
   libocct-data-exchange-dev
+  # ABC's feature files (YAML) for `glint edges label --abc-features`.
+  libyaml-cpp-dev
   # make package: CPack's .deb finds its shared-library dependencies with dpkg-shlibdeps and file.
   dpkg-dev file
   # The optional MPI build (-DGLINT_WITH_MPI=ON) and the MPI test, which runs mpirun.

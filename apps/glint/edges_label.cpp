@@ -6,7 +6,9 @@
 #include <cctype>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
+#include "cad/abc_features.h"
 #include "cad/part.h"
 #include "cad/sample.h"
 #include "cad/step.h"
@@ -28,6 +30,7 @@ struct LabelOptions {
   std::string report;
   std::vector<double> cut_plane;  // normal x, y, z and an optional offset in diagonals
   std::string cut_mode = "clip";
+  std::string abc_features;  // an ABC features YAML whose sharp curves replace the angle
   bool deflection_given = false;
   bool cut_mode_given = false;
   cad::SampleParams params;
@@ -70,6 +73,9 @@ cad::LabelledCloud label_mesh(const LabelOptions& options, nlohmann::json& cut) 
   mesh.vertices.reserve(loaded.vertices.size());
   for (const Eigen::Vector3f& v : loaded.vertices) mesh.vertices.push_back(v.cast<double>());
   for (const Eigen::Vector3i& t : loaded.triangles) mesh.triangles.push_back({t[0], t[1], t[2]});
+  std::optional<cad::EdgeClasses> sharp_curves;
+  if (!options.abc_features.empty())
+    sharp_curves = cad::read_abc_sharp_curves(options.abc_features, mesh.vertices);
   if (!options.cut_plane.empty()) {
     Eigen::Vector3d low = mesh.vertices.front(), high = low;
     for (const Eigen::Vector3d& v : mesh.vertices) low = low.cwiseMin(v), high = high.cwiseMax(v);
@@ -80,14 +86,19 @@ cad::LabelledCloud label_mesh(const LabelOptions& options, nlohmann::json& cut) 
     } catch (const Error& e) {
       throw Error(options.input, "--cut-plane", e.reason());
     }
+    if (sharp_curves) cad::cut_segments(sharp_curves->segments, plane.point, plane.normal);
     cut = {{"point", {plane.point.x(), plane.point.y(), plane.point.z()}},
            {"normal", {plane.normal.x(), plane.normal.y(), plane.normal.z()}},
            {"mode", options.cut_mode}};
   }
-  return cad::sample_mesh(std::move(mesh), options.params, options.input);
+  return cad::sample_mesh(std::move(mesh), options.params, options.input,
+                          sharp_curves ? &*sharp_curves : nullptr);
 }
 
 cad::LabelledCloud label_step(const LabelOptions& options, nlohmann::json& cut) {
+  if (!options.abc_features.empty())
+    throw Error(options.input, "--abc-features",
+                "applies to an ABC mesh (.obj); a STEP part's sharp edges come from its B-rep");
   if (options.cut_mode_given)
     throw Error(options.input, "--cut-mode",
                 "applies to meshes; a STEP part is cut on its B-rep, where the cut is exact");
@@ -152,7 +163,9 @@ void register_edges_label(CLI::App& edges) {
       "own edges: an edge is sharp where its two triangles' normals turn by >= --sharp-angle, a\n"
       "boundary where it has one triangle. That suits meshes whose curved parts are finely\n"
       "tessellated (a few degrees between neighbouring triangles); on a coarse mesh, creases of\n"
-      "the tessellation itself pass the angle.\n"
+      "the tessellation itself pass the angle. For an ABC model, --abc-features takes the\n"
+      "sharp flags of its features file instead (a vertex on a sharp curve is sharp), the\n"
+      "ground truth ABC-trained detectors use.\n"
       "Samplings: 'uniform' (--points random points on the surface), 'vertices' (the nodes of\n"
       "the kernel's tessellation with --deflection, as ABC clouds are, or the mesh's own\n"
       "vertices), 'scan' (1..--viewpoints simulated scanners: scan lines, falling density,\n"
@@ -165,7 +178,10 @@ void register_edges_label(CLI::App& edges) {
       "0.001\n"
       "  glint edges label bracket.step -o bracket-scan.ply --sampling scan --viewpoints 2 "
       "--noise 0.5\n"
-      "  glint edges label part.obj -o part-open.ply --sampling vertices --cut-plane 0,0,1,0.1\n");
+      "  glint edges label part.obj -o part-open.ply --sampling vertices --cut-plane 0,0,1,0.1\n"
+      "  glint edges label 00000050_..._trimesh_000.obj --abc-features "
+      "00000050_..._features_000.yml "
+      "-o abc.ply --sampling vertices\n");
   command->add_option("part", options->input, "STEP file (.step / .stp) or mesh (.obj / .ply)")
       ->required();
   command->add_option("-o,--output", options->output, "Labelled PLY to write")
@@ -224,6 +240,9 @@ void register_edges_label(CLI::App& edges) {
                        "(a jagged border, as deleting the points on one side leaves)")
           ->check(CLI::IsMember({"clip", "drop"}))
           ->capture_default_str();
+  command->add_option("--abc-features", options->abc_features,
+                      "mesh: an ABC features file (.yml) whose curves flagged sharp are the sharp "
+                      "edges (instead of --sharp-angle); boundaries stay the mesh's open borders");
   command->add_option("--report", options->report, "JSON report (edge classes, label counts)");
   command->callback([options, deflection, angular_deflection, cut_mode] {
     options->deflection_given = deflection->count() + angular_deflection->count() > 0;

@@ -584,7 +584,8 @@ LabelledCloud sample_shape(const TopoDS_Shape& shape, const SampleParams& params
   return label_samples(samples, classes, params, centre, diagonal, "brep_edges", rng);
 }
 
-LabelledCloud sample_mesh(SurfaceMesh mesh, const SampleParams& params, const std::string& name) {
+LabelledCloud sample_mesh(SurfaceMesh mesh, const SampleParams& params, const std::string& name,
+                          const EdgeClasses* sharp_curves) {
   check_sample_params(params);
   if (mesh.triangles.empty()) throw Error(name, "", "has no triangles to sample");
   Vec low = mesh.vertices.front(), high = low;
@@ -598,7 +599,19 @@ LabelledCloud sample_mesh(SurfaceMesh mesh, const SampleParams& params, const st
   double area = 0.0;
   for (const auto& t : mesh.triangles) area += triangle_area(mesh, t);
   if (!(area > 0)) throw Error(name, "triangles", "are all degenerate (the surface has no area)");
-  const EdgeClasses classes = classify_mesh_edges(mesh, params.sharp_angle_deg);
+  EdgeClasses classes = classify_mesh_edges(mesh, params.sharp_angle_deg);
+  if (sharp_curves) {
+    std::erase_if(classes.segments, [](const edges::FeatureSegment& segment) {
+      return segment.label == edges::kLabelSharp;
+    });
+    classes.segments.insert(classes.segments.end(), sharp_curves->segments.begin(),
+                            sharp_curves->segments.end());
+    classes.sharp = sharp_curves->sharp;
+    classes.smooth = sharp_curves->smooth;
+    classes.sharp_length = 0.0;
+    for (const edges::FeatureSegment& segment : sharp_curves->segments)
+      classes.sharp_length += (segment.b - segment.a).norm();
+  }
   Rng rng(params.seed);
   Samples samples;
   switch (params.sampling) {
@@ -612,7 +625,11 @@ LabelledCloud sample_mesh(SurfaceMesh mesh, const SampleParams& params, const st
       samples = sample_scan(mesh, params, centre, diagonal, rng);
       break;
   }
-  return label_samples(samples, classes, params, centre, diagonal, "mesh_edges", rng);
+  LabelledCloud result =
+      label_samples(samples, classes, params, centre, diagonal, "mesh_edges", rng);
+  // With ABC's curves, "sharp" and "smooth" count curves, not mesh edges.
+  result.description["sharp_from"] = sharp_curves ? "ABC features" : "dihedral angle";
+  return result;
 }
 
 }  // namespace glint::cad

@@ -94,8 +94,11 @@ struct LabelledCloud {
 LabelledCloud sample_shape(const TopoDS_Shape& shape, const SampleParams& params);
 
 // A triangle mesh (shape units) welded, sampled and labelled from its own edges
-// (classify_mesh_edges); the deflections do not apply. "mesh_edges" in the description counts
-// the edge classes. Throws glint::Error(name, ...) when the mesh has no triangles or no extent.
-LabelledCloud sample_mesh(SurfaceMesh mesh, const SampleParams& params, const std::string& name);
+// (classify_mesh_edges); the deflections do not apply. `sharp_curves`, when given, replaces the
+// sharp edges the mesh's angles find (an ABC features file's curves, abc_features.h); the
+// boundaries stay the mesh's. "mesh_edges" in the description counts the edge classes.
+// Throws glint::Error(name, ...) when the mesh has no triangles or no extent.
+LabelledCloud sample_mesh(SurfaceMesh mesh, const SampleParams& params, const std::string& name,
+                          const EdgeClasses* sharp_curves = nullptr);
 
 }  // namespace glint::cad

@@ -142,4 +142,18 @@ SurfaceMesh cut_mesh(const SurfaceMesh& mesh, const Vec& point, const Vec& norma
   return compact;
 }
 
+void cut_segments(std::vector<edges::FeatureSegment>& segments, const Vec& point,
+                  const Vec& normal) {
+  const Vec n = normal.normalized();
+  std::vector<edges::FeatureSegment> kept;
+  for (edges::FeatureSegment segment : segments) {
+    const double ha = n.dot(segment.a - point), hb = n.dot(segment.b - point);
+    if (ha < 0 && hb < 0) continue;
+    if (ha < 0) segment.a += ha / (ha - hb) * (segment.b - segment.a);
+    if (hb < 0) segment.b += hb / (hb - ha) * (segment.a - segment.b);
+    kept.push_back(segment);
+  }
+  segments = std::move(kept);
+}
+
 }  // namespace glint::cad

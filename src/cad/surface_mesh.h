@@ -7,6 +7,8 @@
 #include <array>
 #include <vector>
 
+#include "edges/feature_index.h"
+
 namespace glint::cad {
 
 struct EdgeClasses;
@@ -39,5 +41,10 @@ enum class CutMode { clip, drop };
 // the normal is zero.
 SurfaceMesh cut_mesh(const SurfaceMesh& mesh, const Eigen::Vector3d& point,
                      const Eigen::Vector3d& normal, CutMode mode = CutMode::clip);
+
+// The parts of the segments on the positive side of the same plane (clipped where they cross
+// it): feature curves given beside a mesh, cut as the mesh is.
+void cut_segments(std::vector<edges::FeatureSegment>& segments, const Eigen::Vector3d& point,
+                  const Eigen::Vector3d& normal);
 
 }  // namespace glint::cad

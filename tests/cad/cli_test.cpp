@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <utility>
+#include <vector>
 
 #include "cad/part.h"
 #include "cad/step.h"
@@ -48,6 +50,12 @@ TEST_F(CliTest, CadSynthThenLabelAStepPart) {
   EXPECT_EQ(refused.exit_code, 1) << refused.output;
   EXPECT_NE(refused.output.find("--cut-mode"), std::string::npos) << refused.output;
   EXPECT_FALSE(fs::exists(path("drop.ply")));
+  std::ofstream(path("features.yml")) << "curves: []\n";
+  const CommandResult features =
+      glint("edges label " + path("part.step") + " -o " + path("drop.ply") + " --abc-features " +
+            path("features.yml"));
+  EXPECT_EQ(features.exit_code, 1) << features.output;
+  EXPECT_NE(features.output.find("--abc-features"), std::string::npos) << features.output;
 }
 
 TEST_F(CliTest, LabelNamesABadStepFileInOneLine) {
@@ -122,6 +130,61 @@ TEST_F(CliTest, LabelRefusesWhatAMeshCannotGiveInOneLine) {
   EXPECT_EQ(label.exit_code, 1);
   EXPECT_NE(label.output.find("points.ply"), std::string::npos) << label.output;
   EXPECT_FALSE(fs::exists(path("out.ply")));
+}
+
+// An ABC features file for the cube of write_cube_obj: the top's edges y = 0 and x = 1 form
+// one sharp curve (vertices 4, 5, 7), the bottom's edge y = 0 a curve flagged smooth.
+void write_cube_features(const std::string& file) {
+  std::ofstream(file) << "curves:\n- sharp: true\n  type: Line\n  vert_indices: [4, 5, 7]\n"
+                         "- sharp: false\n  type: Line\n  vert_indices: [0, 1]\n"
+                         "surfaces:\n- type: Plane\n  vert_indices: [0, 1, 2, 3]\n";
+}
+
+TEST_F(CliTest, LabelAnAbcMeshFromItsFeaturesFile) {
+  write_cube_obj(path("cube.obj"));
+  write_cube_features(path("cube.yml"));
+  const CommandResult label =
+      glint("edges label " + path("cube.obj") + " --abc-features " + path("cube.yml") + " -o " +
+            path("cube.ply") + " --sampling vertices --report " + path("cube.json"));
+  ASSERT_EQ(label.exit_code, 0) << label.output;
+  const PointCloud cloud = io::read_ply(path("cube.ply"));
+  const auto& labels = *cloud.get<std::uint8_t>("label");
+  ASSERT_EQ(cloud.size(), 8u);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3f p = cloud.point(i);
+    // Vertices 4, 5 and 7: (0, 0, 1), (1, 0, 1), (1, 1, 1); the angles would call all 8 sharp.
+    const bool on_curve = p.z() == 1 && (p.y() == 0 || p.x() == 1);
+    EXPECT_EQ(labels[i], on_curve ? 1 : 0) << p.transpose();
+  }
+  const auto report = nlohmann::json::parse(std::ifstream(path("cube.json")));
+  EXPECT_EQ(report["cloud"]["sharp_from"], "ABC features");
+  EXPECT_EQ(report["cloud"]["mesh_edges"]["sharp"], 1);
+  EXPECT_EQ(report["cloud"]["mesh_edges"]["smooth"], 1);
+  EXPECT_DOUBLE_EQ(report["cloud"]["mesh_edges"]["sharp_length"].get<double>(), 2.0);
+}
+
+TEST_F(CliTest, LabelNamesABadFeaturesFileAndItsElementInOneLine) {
+  write_cube_obj(path("cube.obj"));
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"curves: [\n", "line 2"},
+      {"surfaces: []\n", "curves"},
+      {"curves:\n- type: Line\n  vert_indices: [1]\n", "curves[0].sharp"},
+      {"curves:\n- sharp: maybe\n  vert_indices: [1]\n", "curves[0].sharp"},
+      {"curves:\n- sharp: true\n", "curves[0].vert_indices"},
+      {"curves:\n- sharp: true\n  vert_indices: [4, 8]\n", "curves[0].vert_indices[1]"}};
+  for (const auto& [text, element] : cases) {
+    std::ofstream(path("bad.yml")) << text;
+    const CommandResult label = glint("edges label " + path("cube.obj") + " --abc-features " +
+                                      path("bad.yml") + " -o " + path("out.ply"));
+    EXPECT_EQ(label.exit_code, 1) << text;
+    EXPECT_NE(label.output.find("bad.yml: " + element + ":"), std::string::npos) << label.output;
+    EXPECT_EQ(std::count(label.output.begin(), label.output.end(), '\n'), 1) << label.output;
+    EXPECT_FALSE(fs::exists(path("out.ply")));
+  }
+  const CommandResult missing = glint("edges label " + path("cube.obj") + " --abc-features " +
+                                      path("none.yml") + " -o " + path("out.ply"));
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.output.find("none.yml"), std::string::npos) << missing.output;
 }
 
 }  // namespace

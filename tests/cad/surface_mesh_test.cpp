@@ -104,6 +104,17 @@ TEST(SurfaceMesh, ADropCutEndsAtTheLastWholeTriangles) {
   EXPECT_EQ(cut.vertices.size(), 3u * 64u + 1u);  // three rings and the top centre
 }
 
+TEST(SurfaceMesh, FeatureSegmentsAreCutAsTheMeshIs) {
+  std::vector<edges::FeatureSegment> segments{{Vec(0, 0, -1), Vec(0, 0, 1), edges::kLabelSharp},
+                                              {Vec(1, 0, 0.5), Vec(1, 0, 2), edges::kLabelSharp},
+                                              {Vec(2, 0, -2), Vec(2, 0, -1), edges::kLabelSharp}};
+  cut_segments(segments, Vec(0, 0, 0.25), Vec(0, 0, 2));
+  ASSERT_EQ(segments.size(), 2u);
+  EXPECT_NEAR(segments[0].a.z(), 0.25, 1e-12);  // clipped where it crosses
+  EXPECT_NEAR(segments[0].b.z(), 1.0, 1e-12);
+  EXPECT_NEAR(segments[1].a.z(), 0.5, 1e-12);  // wholly kept
+}
+
 TEST(SurfaceMesh, ACutThatKeepsNothingFails) {
   EXPECT_THROW(cut_mesh(unit_cube(), Vec(0, 0, 2), Vec(0, 0, 1)), Error);
   EXPECT_THROW(cut_mesh(unit_cube(), Vec(0, 0, 0.5), Vec::Zero()), Error);
