@@ -46,13 +46,15 @@ EdgeClasses read_abc_sharp_curves(const std::string& path,
     ++classes.sharp;
     long previous = -1;
     for (std::size_t k = 0; k < indices.size(); ++k) {
+      const std::string element = fmt::format("{}.vert_indices[{}]", where, k);
       long index = -1;
       try {
         index = indices[k].as<long>();
       } catch (const YAML::Exception&) {
+        throw Error(path, element, "is not an integer");
       }
       if (index < 0 || index >= long(vertices.size()))
-        throw Error(path, fmt::format("{}.vert_indices[{}]", where, k),
+        throw Error(path, element,
                     fmt::format("is not a vertex of the mesh ({} vertices)", vertices.size()));
       if (previous >= 0 && previous != index) {
         classes.segments.push_back(

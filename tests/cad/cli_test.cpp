@@ -171,7 +171,8 @@ TEST_F(CliTest, LabelNamesABadFeaturesFileAndItsElementInOneLine) {
       {"curves:\n- type: Line\n  vert_indices: [1]\n", "curves[0].sharp"},
       {"curves:\n- sharp: maybe\n  vert_indices: [1]\n", "curves[0].sharp"},
       {"curves:\n- sharp: true\n", "curves[0].vert_indices"},
-      {"curves:\n- sharp: true\n  vert_indices: [4, 8]\n", "curves[0].vert_indices[1]"}};
+      {"curves:\n- sharp: true\n  vert_indices: [4, 8]\n", "curves[0].vert_indices[1]"},
+      {"curves:\n- sharp: true\n  vert_indices: [4, x]\n", "curves[0].vert_indices[1]"}};
   for (const auto& [text, element] : cases) {
     std::ofstream(path("bad.yml")) << text;
     const CommandResult label = glint("edges label " + path("cube.obj") + " --abc-features " +
