@@ -538,6 +538,8 @@ void check_part_params(const PartParams& p) {
 std::array<Eigen::Vector3d, 2> shape_bounds(const TopoDS_Shape& shape) {
   Bnd_Box box;
   BRepBndLib::Add(shape, box);
+  // An unbounded face (e.g. a plane without edges) has an open box, which OCCT reports as
+  // ±1e100: deflections and spacings derived from it would mesh nothing.
   if (box.IsVoid() || box.IsOpen())
     throw Error("shape", "bounding box", "is empty or unbounded (a face without a boundary)");
   double x0, y0, z0, x1, y1, z1;

@@ -5,12 +5,10 @@
 
 #include <BRepAdaptor_Curve.hxx>
 #include <BRepAdaptor_Surface.hxx>
-#include <BRepBndLib.hxx>
 #include <BRepLProp_SLProps.hxx>
 #include <BRepMesh_IncrementalMesh.hxx>
 #include <BRepTools.hxx>
 #include <BRep_Tool.hxx>
-#include <Bnd_Box.hxx>
 #include <Eigen/Geometry>
 #include <GCPnts_TangentialDeflection.hxx>
 #include <Geom2d_Curve.hxx>
@@ -27,6 +25,7 @@
 #include <random>
 #include <unordered_map>
 
+#include "cad/part.h"
 #include "cad/surface_mesh.h"
 #include "core/error.h"
 #include "geometry/weld.h"
@@ -546,15 +545,7 @@ LabelledCloud sample_shape(const TopoDS_Shape& shape, const SampleParams& params
   check_sample_params(params);
   if (shape.IsNull() || !TopExp_Explorer(shape, TopAbs_FACE).More())
     throw Error("shape", "", "has no faces to sample");
-  Bnd_Box box;
-  BRepBndLib::Add(shape, box);
-  // An unbounded face (e.g. a plane without edges) has an open box, which OCCT reports as
-  // ±1e100: deflections and spacings derived from it would mesh nothing.
-  if (box.IsVoid() || box.IsOpen())
-    throw Error("shape", "bounding box", "is empty or unbounded (a face without a boundary)");
-  double x0, y0, z0, x1, y1, z1;
-  box.Get(x0, y0, z0, x1, y1, z1);
-  const Vec low(x0, y0, z0), high(x1, y1, z1);
+  const auto [low, high] = shape_bounds(shape);
   const Vec centre = 0.5 * (low + high);
   const double diagonal = (high - low).norm();
   Rng rng(params.seed);
