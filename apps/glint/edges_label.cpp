@@ -2,8 +2,6 @@
 // PLY), labelled cloud out.
 #include <fmt/format.h>
 
-#include <algorithm>
-#include <cctype>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -16,6 +14,7 @@
 #include "cli_support.h"
 #include "commands.h"
 #include "core/error.h"
+#include "io/codec.h"
 #include "io/json_report.h"
 #include "io/ply.h"
 #include "render/mesh_loader.h"
@@ -38,9 +37,7 @@ struct LabelOptions {
 
 // Whether the input is a STEP part (else a mesh); throws for any other extension.
 bool is_step(const std::string& path) {
-  std::string extension = std::filesystem::path(path).extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return char(std::tolower(c)); });
+  const std::string extension = io::lowercase(std::filesystem::path(path).extension().string());
   if (extension == ".step" || extension == ".stp") return true;
   if (extension == ".obj" || extension == ".ply") return false;
   throw Error(path, "", "unknown format (expected .step, .stp, .obj or .ply)");
@@ -50,6 +47,10 @@ bool is_step(const std::string& path) {
 // the normal.
 struct CutPlane {
   Eigen::Vector3d point, normal;
+
+  nlohmann::json json() const {
+    return {{"point", io::vector_json(point)}, {"normal", io::vector_json(normal)}};
+  }
 };
 
 CutPlane cut_plane(const std::vector<double>& values, const Eigen::Vector3d& low,
@@ -87,9 +88,8 @@ cad::LabelledCloud label_mesh(const LabelOptions& options, nlohmann::json& cut) 
       throw Error(options.input, "--cut-plane", e.reason());
     }
     if (sharp_curves) cad::cut_segments(sharp_curves->segments, plane.point, plane.normal);
-    cut = {{"point", {plane.point.x(), plane.point.y(), plane.point.z()}},
-           {"normal", {plane.normal.x(), plane.normal.y(), plane.normal.z()}},
-           {"mode", options.cut_mode}};
+    cut = plane.json();
+    cut["mode"] = options.cut_mode;
   }
   return cad::sample_mesh(std::move(mesh), options.params, options.input,
                           sharp_curves ? &*sharp_curves : nullptr);
@@ -111,8 +111,7 @@ cad::LabelledCloud label_step(const LabelOptions& options, nlohmann::json& cut) 
     } catch (const Error& e) {
       throw Error(options.input, "--cut-plane", e.reason());
     }
-    cut = {{"point", {plane.point.x(), plane.point.y(), plane.point.z()}},
-           {"normal", {plane.normal.x(), plane.normal.y(), plane.normal.z()}}};
+    cut = plane.json();
   }
   return cad::sample_shape(shape, options.params);
 }

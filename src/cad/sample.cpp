@@ -89,8 +89,7 @@ void refine(SurfaceMesh& mesh, double max_edge) {
       continue;
     }
     const int a = t[longest], b = t[(longest + 1) % 3], c = t[(longest + 2) % 3];
-    const std::uint64_t key = (std::uint64_t(std::min(a, b)) << 32) | std::uint32_t(std::max(a, b));
-    auto [it, inserted] = midpoints.emplace(key, static_cast<int>(mesh.vertices.size()));
+    auto [it, inserted] = midpoints.emplace(edge_key(a, b), static_cast<int>(mesh.vertices.size()));
     if (inserted) mesh.vertices.push_back(0.5 * (mesh.vertices[a] + mesh.vertices[b]));
     todo.push_back({a, it->second, c});
     todo.push_back({it->second, b, c});
@@ -134,9 +133,8 @@ class SurfaceSampler {
   double area_ = 0.0;
 };
 
-// The mesh's own vertices (welded; long edges split when plane_edge_fraction asks).
+// The vertices of a welded mesh (long edges split when plane_edge_fraction asks).
 Samples sample_vertices(SurfaceMesh mesh, const SampleParams& p, double diagonal, Rng& rng) {
-  geometry::weld_vertices(mesh, 1e-7 * diagonal);
   if (p.plane_edge_fraction > 0.0) refine(mesh, p.plane_edge_fraction * diagonal);
   const std::size_t n = mesh.vertices.size();
   std::vector<Vec> normals(n, Vec::Zero());
@@ -555,13 +553,16 @@ LabelledCloud sample_shape(const TopoDS_Shape& shape, const SampleParams& params
   try {
     classes = classify_edges(shape, params.sharp_angle_deg, 1e-4 * diagonal);
     switch (params.sampling) {
-      case Sampling::vertices:
-        samples = sample_vertices(tessellate(shape, params.linear_deflection * diagonal,
-                                             params.angular_deflection_deg * kPi / 180.0),
-                                  params, diagonal, rng);
+      case Sampling::vertices: {
+        // Each face is triangulated apart: its copies of the edges' nodes are welded.
+        SurfaceMesh mesh = tessellate(shape, params.linear_deflection * diagonal,
+                                      params.angular_deflection_deg * kPi / 180.0);
+        geometry::weld_vertices(mesh, 1e-7 * diagonal);
+        samples = sample_vertices(std::move(mesh), params, diagonal, rng);
         samples.description["linear_deflection"] = params.linear_deflection;
         samples.description["angular_deflection_degrees"] = params.angular_deflection_deg;
         break;
+      }
       case Sampling::uniform:
         samples = sample_uniform(fine_mesh(shape, diagonal), params, rng);
         break;
@@ -607,7 +608,7 @@ LabelledCloud sample_mesh(SurfaceMesh mesh, const SampleParams& params, const st
   Samples samples;
   switch (params.sampling) {
     case Sampling::vertices:
-      samples = sample_vertices(mesh, params, diagonal, rng);
+      samples = sample_vertices(std::move(mesh), params, diagonal, rng);
       break;
     case Sampling::uniform:
       samples = sample_uniform(mesh, params, rng);

@@ -15,10 +15,6 @@ namespace {
 using Vec = Eigen::Vector3d;
 constexpr double kPi = 3.14159265358979323846;
 
-std::uint64_t edge_key(int a, int b) {
-  return (std::uint64_t(std::min(a, b)) << 32) | std::uint32_t(std::max(a, b));
-}
-
 }  // namespace
 
 Vec triangle_normal(const SurfaceMesh& mesh, const std::array<int, 3>& t) {

@@ -4,7 +4,9 @@
 // curves come from the mesh itself: its edges are classified by the turn of the normals of the
 // triangles beside them, the rule classify_edge applies to a B-rep edge's two faces.
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include "edges/feature_index.h"
@@ -17,6 +19,11 @@ struct SurfaceMesh {
   std::vector<Eigen::Vector3d> vertices;
   std::vector<std::array<int, 3>> triangles;  // counter-clockwise seen from outside, if known
 };
+
+// One key for the edge between vertices a and b, whichever way it is run.
+inline std::uint64_t edge_key(int a, int b) {
+  return (std::uint64_t(std::min(a, b)) << 32) | std::uint32_t(std::max(a, b));
+}
 
 // Unit normal of a triangle by its winding ((0, 0, 1) for a degenerate one) and its area.
 Eigen::Vector3d triangle_normal(const SurfaceMesh& mesh, const std::array<int, 3>& t);
