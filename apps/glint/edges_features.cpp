@@ -21,6 +21,7 @@ struct FeaturesOptions {
   std::string output;
   std::vector<int> scales{128, 64, 32, 16};
   bool angular_gap = false;
+  bool area_weights = false;
 };
 
 constexpr std::array<const char*, edges::kAngularGapFeature + 1> kFeatureNames = {
@@ -55,6 +56,7 @@ void run_features(const FeaturesOptions& options) {
   edges::FeatureParams params;
   params.scales = options.scales;
   params.angular_gap = options.angular_gap;
+  params.area_weights = options.area_weights;
   edges::FeatureMatrix features;
   try {
     features = edges::compute_features(cloud, params);
@@ -92,6 +94,9 @@ void register_edges_features(CLI::App& edges) {
                     "Add angular_gap per scale: the largest empty sector of the neighbours around "
                     "the normal, as a fraction of the turn (the shipped 3-class model's 13th "
                     "input)");
+  command->add_flag("--area-weights", options->area_weights,
+                    "Weigh each neighbour by the surface it stands for (as a model trained with "
+                    "edges train --area-weights; docs/edges.md \"features\")");
   command->callback([options] { run_features(*options); });
 }
 

@@ -179,6 +179,11 @@ void register_edges_train(CLI::App& edges) {
                     "Add a thirteenth input per scale: the largest empty sector of the neighbours "
                     "around the normal (PCL's boundary rule, graded; the shipped 3-class model "
                     "has it)");
+  command->add_flag("--area-weights", options->config.area_weights,
+                    "Weigh each neighbour by the surface it stands for (its squared distance to "
+                    "its 8th nearest point, relative to the query's, clamped to [1/16, 16]): "
+                    "features that follow the surface rather than the sampling density, e.g. "
+                    "the mesh vertices of CAD tessellations");
   command
       ->add_option("--exclude", options->exclude,
                    "Skip files whose name contains PATTERN; repeat the flag for more patterns "

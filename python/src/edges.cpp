@@ -36,10 +36,12 @@ py::tuple classify(const py::object& xyz, const py::object& model, const py::obj
                         array_from_vector(std::move(probs), {py::ssize_t(n), 2}));
 }
 
-py::array features(const py::object& xyz, const py::object& scales_arg, bool angular_gap) {
+py::array features(const py::object& xyz, const py::object& scales_arg, bool angular_gap,
+                   bool area_weights) {
   edges::FeatureParams params;
   if (!scales_arg.is_none()) params.scales = scales_from(scales_arg);
   params.angular_gap = angular_gap;
+  params.area_weights = area_weights;
   const PointCloud cloud = cloud_from_array(xyz, "xyz");
   edges::FeatureMatrix matrix;
   {
@@ -78,7 +80,7 @@ Raises:
 
 The GIL is released while the features and the network run.)");
   m.def("features", &features, py::arg("xyz"), py::arg("scales") = py::none(),
-        py::arg("angular_gap") = false,
+        py::arg("angular_gap") = false, py::arg("area_weights") = false,
         R"(BoundED's multi-scale neighbourhood features (thesis eqs. 5.1-5.21), as
 `glint edges features`.
 
@@ -87,6 +89,9 @@ Args:
     scales: neighbourhood sizes, largest first; None = [128, 64, 32, 16], the CLI's default.
     angular_gap: also angular_gap per scale (the largest empty sector of the neighbours
         around the normal, as a fraction of the turn), as `--angular-gap`.
+    area_weights: weigh each neighbour by the surface it stands for (its squared distance
+        to its 8th nearest point relative to the query's, clamped to [1/16, 16]), as
+        `--area-weights`.
 
 Returns:
     (N, F * len(scales)) float32, scale-major, F = 12 (13 with angular_gap): per scale

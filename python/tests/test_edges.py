@@ -85,6 +85,11 @@ def test_features_equal_cli(cloud_file, cli, tmp_path):
     np.testing.assert_array_equal(with_gap[:, [*range(12), *range(13, 25)]], features)
     assert ((with_gap[:, [12, 25]] >= 0) & (with_gap[:, [12, 25]] <= 1)).all()
 
+    cli("edges", "features", cloud_file, "-o", out, "--scales", "32,16", "--area-weights")
+    by_area = glint.edges.features(xyz, scales=[32, 16], area_weights=True)
+    assert by_area.shape == features.shape and np.isfinite(by_area).all()
+    np.testing.assert_array_equal(by_area, np.load(out))
+
 
 def test_bad_inputs_raise_glint_error():
     with pytest.raises(glint.Error, match=r"xyz: must be an \(N, 3\) array of positions, got "

@@ -47,6 +47,7 @@ std::vector<Classification> run_networks(const PointCloud& cloud,
   FeatureParams params;
   params.scales = scales;
   params.angular_gap = networks.front()->config.angular_gap;
+  params.area_weights = networks.front()->config.area_weights;
   const int scale_count = static_cast<int>(scales.size());
   const int per_scale = params.per_scale();
   const std::size_t row_size = params.row_size();

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "core/cpu_level.h"
@@ -67,6 +68,7 @@ struct Scratch {
   // Rows handed out in blocks (compute_features_in_blocks): the block's points and rows.
   std::vector<std::uint32_t> block_points;
   std::vector<float> block_rows;
+  std::vector<float> weights;  // area weights of the current neighbourhood
   std::vector<ScaleState> states;
   std::vector<geometry::SymmetricMatrix3> matrices;
   std::vector<Vector3d> eigenvalues;
@@ -88,12 +90,13 @@ std::uint64_t bytes_equal_to(std::uint64_t word, std::uint8_t value) {
   return ~(((x & kLow7) + kLow7) | x | kLow7);
 }
 
-// Moments of the `count` neighbours closest to `centre` (§5.4.1: the normal is fitted to the
-// floor(k/2) points nearest the centre of mass, which keeps it stable near outliers).
-// Bucketing by squared distance finds the cut without sorting: whole buckets below the cut are
-// summed branch-free, only the bucket that straddles it is sorted.
+// Moments of the `count` neighbours closest to `centre`, each with weight weight_of(j) (§5.4.1:
+// the normal is fitted to the floor(k/2) points nearest the centre of mass, which keeps it
+// stable near outliers). Bucketing by squared distance finds the cut without sorting: whole
+// buckets below the cut are summed branch-free, only the bucket that straddles it is sorted.
+template <class WeightOf>
 Moments moments_nearest_to(const geometry::Neighbourhood& nb, int k, const Vector3d& centre,
-                           int count, Scratch& scratch) {
+                           int count, WeightOf weight_of, Scratch& scratch) {
   constexpr int buckets = Scratch::kBuckets;
   scratch.squared_distances.resize(k);
   // Padded to whole 8-byte words with a value no bucket has (bytes_equal_to reads words).
@@ -134,7 +137,8 @@ Moments moments_nearest_to(const geometry::Neighbourhood& nb, int k, const Vecto
     }
   }
 
-  Moments nearest = sum_moments(nb, 0, k, [&](int j) { return bucket_of[j] < cut ? 1.f : 0.f; });
+  Moments nearest =
+      sum_moments(nb, 0, k, [&](int j) { return bucket_of[j] < cut ? weight_of(j) : 0.f; });
   // The straddling bucket's members (a few of k), found eight buckets at a time.
   scratch.straddling.clear();
   for (int word = 0; word < k; word += 8) {
@@ -148,7 +152,7 @@ Moments moments_nearest_to(const geometry::Neighbourhood& nb, int k, const Vecto
   std::sort(scratch.straddling.begin(), scratch.straddling.end());
   for (int r = 0; r < count - below; ++r) {
     const auto j = static_cast<std::uint32_t>(scratch.straddling[r]);
-    nearest.add(nb.dx[j], nb.dy[j], nb.dz[j]);
+    nearest.add_weighted(nb.dx[j], nb.dy[j], nb.dz[j], weight_of(int(j)));
   }
   return nearest;
 }
@@ -225,18 +229,39 @@ void scale_features(const ScaleState& state, const ScaleState& largest, const Ve
   split_along(-state.centre * scale, normal, out[8], out[9]);  // eqs. (5.11)-(5.12)
 
   if (largest.k > state.k) {
-    // Centre of the largest scale's points that are not in this scale, eqs. (5.17)-(5.18).
-    const Vector3d rest =
-        (largest.centre * largest.k - state.centre * state.k) / double(largest.k - state.k);
+    // Centre of the largest scale's points that are not in this scale, eqs. (5.17)-(5.18);
+    // counts are the weighted ones (k and k0 without area weights).
+    const double n = state.all.count(), largest_n = largest.all.count();
+    const Vector3d rest = (largest.centre * largest_n - state.centre * n) / (largest_n - n);
     split_along((state.centre - rest) * scale, largest.normal, out[10], out[11]);
   }
 }
 
+// The area weights of neighbourhood nb (features.h), from every point's squared spacing.
+const float* area_weights(const geometry::Neighbourhood& nb, const float* squared_spacings,
+                          Scratch& scratch) {
+  scratch.weights.resize(std::size_t(nb.size));
+  float* weights = scratch.weights.data();
+  // A query with duplicates closer than its spacing neighbour has spacing 0: the clamp decides.
+  const float query = std::max(squared_spacings[nb.point], std::numeric_limits<float>::min());
+  for (int j = 0; j < nb.size; ++j)
+    weights[j] =
+        std::clamp(squared_spacings[nb.indices[j]] / query, 1.0f / kMaxAreaWeight, kMaxAreaWeight);
+  return weights;
+}
+
 // All scales of one point. The neighbour list is ordered nearest first, so the moments of
 // every scale come from one pass with prefix sums; the eigen solves of all scales run as two
-// batches (vectorised across matrices).
+// batches (vectorised across matrices). Neighbours weigh 1, or their area weight when
+// squared_spacings is given (kAreaWeights).
+template <bool kAreaWeights>
 void point_features(const geometry::Neighbourhood& nb, const FeatureParams& params,
-                    Scratch& scratch, float* row) {
+                    const float* squared_spacings, Scratch& scratch, float* row) {
+  const float* weights = kAreaWeights ? area_weights(nb, squared_spacings, scratch) : nullptr;
+  const auto weight = [weights](int j) {
+    if constexpr (kAreaWeights) return weights[j];
+    return 1.f;
+  };
   const std::vector<int>& scales = params.scales;
   const int count = static_cast<int>(scales.size());
   const int per_scale = params.per_scale();
@@ -249,7 +274,7 @@ void point_features(const geometry::Neighbourhood& nb, const FeatureParams& para
   Moments prefix;
   int added = 0;
   for (int s = count - 1; s >= 0; --s) {
-    prefix = prefix.plus(sum_moments(nb, added, scales[s], [](int) { return 1.f; }));
+    prefix = prefix.plus(sum_moments(nb, added, scales[s], weight));
     added = scales[s];
     states[s].k = scales[s];
     states[s].all = prefix;
@@ -262,7 +287,7 @@ void point_features(const geometry::Neighbourhood& nb, const FeatureParams& para
     state.centre = state.all.mean();
     matrices[s] = state.all.covariance();
     matrices[count + s] =
-        moments_nearest_to(nb, state.k, state.centre, std::max(3, state.k / 2), scratch)
+        moments_nearest_to(nb, state.k, state.centre, std::max(3, state.k / 2), weight, scratch)
             .covariance();
   }
   geometry::eigenvalues_descending(matrices.data(), 2 * count, eigenvalues.data());
@@ -280,7 +305,7 @@ void point_features(const geometry::Neighbourhood& nb, const FeatureParams& para
     const float nx = float(normal.x()), ny = float(normal.y()), nz = float(normal.z());
     const float plane = float(state.centre.dot(normal));
     state.upper = sum_moments(nb, 0, state.k, [&](int j) {
-      return nb.dx[j] * nx + nb.dy[j] * ny + nb.dz[j] * nz >= plane ? 1.f : 0.f;
+      return nb.dx[j] * nx + nb.dy[j] * ny + nb.dz[j] * nz >= plane ? weight(j) : 0.f;
     });
     state.lower = state.all.minus(state.upper);
     matrices[s] = state.upper.count() > 0 ? state.upper.covariance() : geometry::SymmetricMatrix3{};
@@ -298,20 +323,30 @@ void point_features(const geometry::Neighbourhood& nb, const FeatureParams& para
   }
 }
 
-using PointKernel = void (*)(const geometry::Neighbourhood&, const FeatureParams&, Scratch&,
-                             float*);
+using PointKernel = void (*)(const geometry::Neighbourhood&, const FeatureParams&, const float*,
+                             Scratch&, float*);
+
+void point_features_either(const geometry::Neighbourhood& nb, const FeatureParams& params,
+                           const float* squared_spacings, Scratch& scratch, float* row) {
+  if (squared_spacings)
+    point_features<true>(nb, params, squared_spacings, scratch, row);
+  else
+    point_features<false>(nb, params, nullptr, scratch, row);
+}
 
 [[gnu::flatten]] void point_features_baseline(const geometry::Neighbourhood& nb,
-                                              const FeatureParams& params, Scratch& scratch,
+                                              const FeatureParams& params,
+                                              const float* squared_spacings, Scratch& scratch,
                                               float* row) {
-  point_features(nb, params, scratch, row);
+  point_features_either(nb, params, squared_spacings, scratch, row);
 }
 #if defined(__x86_64__)
 // The same code in eight-lane vectors with fused multiply-adds: the moment sums round in
 // another order, so features differ from the baseline's by float rounding.
 [[gnu::target("arch=x86-64-v3"), gnu::flatten]] void point_features_x86_64_v3(
-    const geometry::Neighbourhood& nb, const FeatureParams& params, Scratch& scratch, float* row) {
-  point_features(nb, params, scratch, row);
+    const geometry::Neighbourhood& nb, const FeatureParams& params, const float* squared_spacings,
+    Scratch& scratch, float* row) {
+  point_features_either(nb, params, squared_spacings, scratch, row);
 }
 #endif
 
@@ -370,6 +405,25 @@ void check_cloud(const PointCloud& cloud, const FeatureParams& params) {
   }
 }
 
+// Every point's squared distance to its kAreaSpacingNeighbour-th nearest other point (or the
+// farthest, in a smaller cloud): the area it stands for, up to a constant.
+std::vector<float> squared_spacings(const PointCloud& cloud) {
+  std::vector<float> spacings(cloud.size());
+  geometry::NeighbourhoodParams search;
+  search.k =
+      static_cast<int>(std::min(cloud.size(), static_cast<std::size_t>(kAreaSpacingNeighbour + 1)));
+  ProgressBar progress("spacings", cloud.size());
+  geometry::for_each_neighbourhood(
+      cloud, search,
+      [&](const geometry::Neighbourhood& nb) {
+        const int last = nb.size - 1;
+        spacings[nb.point] =
+            nb.dx[last] * nb.dx[last] + nb.dy[last] * nb.dy[last] + nb.dz[last] * nb.dz[last];
+      },
+      [&](std::size_t done) { progress.advance(done); });
+  return spacings;
+}
+
 // Every point's features, written to row_for(point, scratch); row_written(scratch) follows
 // on the same thread. The cloud must have passed check_cloud.
 template <class RowFor, class RowWritten>
@@ -377,6 +431,9 @@ void compute_rows(const PointCloud& cloud, const FeatureParams& params,
                   tbb::enumerable_thread_specific<Scratch>& scratches, RowFor&& row_for,
                   RowWritten&& row_written) {
   const PointKernel kernel = point_kernel();
+  const std::vector<float> spacings =
+      params.area_weights ? squared_spacings(cloud) : std::vector<float>();
+  const float* spacing_of = params.area_weights ? spacings.data() : nullptr;
   geometry::NeighbourhoodParams search;
   search.k = params.scales[0];
   ProgressBar progress("features", cloud.size());
@@ -384,7 +441,7 @@ void compute_rows(const PointCloud& cloud, const FeatureParams& params,
       cloud, search,
       [&](const geometry::Neighbourhood& nb) {
         Scratch& scratch = scratches.local();
-        kernel(nb, params, scratch, row_for(nb.point, scratch));
+        kernel(nb, params, spacing_of, scratch, row_for(nb.point, scratch));
         row_written(scratch);
       },
       [&](std::size_t done) { progress.advance(done); });

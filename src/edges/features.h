@@ -19,6 +19,12 @@
 // All lengths are in the normalised frame of eq. (5.4) of the scale they belong to, so the
 // features do not depend on the cloud's unit or density.
 //
+// With FeatureParams::area_weights (our addition) every sum over neighbours weighs neighbour j
+// by the surface it stands for, relative to the query's: w_j = (r_j / r_q)^2 clamped to
+// [1/16, 16], r = distance to the 8th nearest other point. The sums then approximate integrals
+// over the surface rather than over the samples, so a sparse face beside a densely tessellated
+// one (mesh vertices of a CAD part) weighs by its area, not by its vertex count.
+//
 // Our decisions where the thesis is silent: the normal n (eigenvector of the smallest
 // eigenvalue of the floor(k/2) neighbours closest to the centre, as in the thesis) is oriented
 // so that s_perp >= 0, i.e. the query point lies in the upper half-space. This makes convex
@@ -35,6 +41,11 @@ namespace glint::edges {
 
 inline constexpr int kThesisFeaturesPerScale = 12;
 inline constexpr int kAngularGapFeature = 12;
+// Area weights: r is the distance to this nearest other point; weights are clamped to
+// [1/kMaxAreaWeight, kMaxAreaWeight] so that an outlier's wide spacing cannot outweigh its
+// neighbourhood.
+inline constexpr int kAreaSpacingNeighbour = 8;
+inline constexpr float kMaxAreaWeight = 16.0f;
 
 // Values per scale: the thesis's twelve, or thirteen with the angular gap.
 inline int features_per_scale(bool angular_gap) {
@@ -44,7 +55,8 @@ inline int features_per_scale(bool angular_gap) {
 struct FeatureParams {
   // Neighbourhood sizes, largest first (the largest one is the k0 of eq. 5.17).
   std::vector<int> scales{128, 64, 32, 16};
-  bool angular_gap = false;  // the thirteenth value per scale
+  bool angular_gap = false;   // the thirteenth value per scale
+  bool area_weights = false;  // neighbours weighed by the surface they stand for
   int per_scale() const { return features_per_scale(angular_gap); }
   std::size_t row_size() const { return scales.size() * std::size_t(per_scale()); }
 };

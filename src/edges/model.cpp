@@ -141,6 +141,7 @@ void Model::check() const {
     if (low_noise->gated()) throw Error(where, "noise_gate", "the gate's network has a gate");
     if (low_noise->config.classes != config.classes || low_noise->config.scales != config.scales ||
         low_noise->config.angular_gap != config.angular_gap ||
+        low_noise->config.area_weights != config.area_weights ||
         low_noise->layers.size() != layers.size())
       throw Error(where, "noise_gate.low_noise",
                   "the gate's network must have the same classes, scales, inputs and layers");
@@ -231,6 +232,7 @@ nlohmann::json Model::to_json() const {
                          {"classes", class_names(config.classes)},
                          {"scales", config.scales},
                          {"features_per_scale", config.features_per_scale()},
+                         {"neighbour_weights", config.area_weights ? "area" : "count"},
                          {"fusion_width", config.fusion_width},
                          {"hidden", config.hidden},
                          {"hidden_layers", config.hidden_layers},
@@ -266,6 +268,14 @@ Model Model::load(const std::string& path) {
 
   ModelConfig config;
   config.angular_gap = features == features_per_scale(true);
+  // Files written before area weights existed have no key: their neighbours weigh 1.
+  if (root.contains("neighbour_weights")) {
+    const std::string weights = reader.string(root, "neighbour_weights");
+    if (weights != "count" && weights != "area")
+      reader.fail("neighbour_weights",
+                  fmt::format("expected \"count\" or \"area\", got \"{}\"", weights));
+    config.area_weights = weights == "area";
+  }
   config.classes = class_count;
   config.scales = reader.integers(root, "scales");
   config.fusion_width = reader.integer(root, "fusion_width");

@@ -39,10 +39,11 @@ struct ModelConfig {
   int hidden_layers = 3;                     // number of hidden head layers
   float leaky_slope = 0.01f;                 // LeakyReLU negative slope
   bool angular_gap = false;                  // inputs: the thesis's 12 per scale, or 13
+  bool area_weights = false;                 // neighbours weighed by area (edges/features.h)
   int features_per_scale() const { return edges::features_per_scale(angular_gap); }
   // Input columns of the network: the feature row of one point.
   std::size_t input_columns() const { return scales.size() * std::size_t(features_per_scale()); }
-  FeatureParams feature_params() const { return FeatureParams{scales, angular_gap}; }
+  FeatureParams feature_params() const { return FeatureParams{scales, angular_gap, area_weights}; }
 };
 
 // Throws glint::Error when a config cannot describe a network: classes not 2 or 3, scale

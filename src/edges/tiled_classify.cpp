@@ -436,7 +436,14 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
         }
       });
   world.sum(counts);
-  const std::vector<double> halos = column_halos(grid, counts, k);
+  std::vector<double> halos = column_halos(grid, counts, k);
+  if (model.config.area_weights) {
+    // A core point's neighbour j lies within the halo h of it, and j's own spacing neighbour
+    // within j's k-th neighbour distance, at most 2h (the core point's k nearest are all within
+    // h of it, so within 2h of j): the tile must reach 3h for the weights to be the whole
+    // cloud's.
+    for (double& halo : halos) halo *= 3.0;
+  }
 
   // The largest tiles whose points, halo included, fit the limit.
   ColumnSums sums(grid, counts);

@@ -104,6 +104,37 @@ TEST(Features, AngularGapIsHalfATurnOnABorder) {
   EXPECT_LE(f.at(interior, 3, kAngularGapFeature), 0.3f);  // k = 16: ~15 neighbours
 }
 
+// A plane sampled 16 times more densely (spacing h against 4h) left of x = 0 than right of it.
+// By count the neighbourhood of a point on the dense side of the seam is mostly dense points:
+// its centre lies well inside, as at a border. Weighed by area the sparse side counts as much
+// as the dense one and the centre comes back towards the point.
+TEST(Features, AreaWeightsBalanceADensitySeam) {
+  std::mt19937 rng(4);
+  PointCloud plane;
+  add_patch(plane, 40, 120, h, rng, [](float u, float v) { return Eigen::Vector3f(-u, v, 0.f); });
+  add_patch(plane, 10, 30, 4 * h, rng,
+            [](float u, float v) { return Eigen::Vector3f(u + 4 * h, v, 0.f); });
+  FeatureParams weighted;
+  weighted.area_weights = true;
+  const FeatureMatrix by_area = compute_features(plane, weighted);
+  const FeatureMatrix by_count = compute_features(plane);
+  const std::size_t seam = nearest_to(plane, {0.f, 0.6f, 0.f});
+  for (int s = 0; s < 2; ++s) {  // k = 128, 64: neighbourhoods that reach across the seam
+    EXPECT_GT(by_count.at(seam, s, kSPar), 0.6f) << "scale " << s;
+    EXPECT_LT(by_area.at(seam, s, kSPar), 0.5f * by_count.at(seam, s, kSPar)) << "scale " << s;
+    EXPECT_NEAR(by_area.at(seam, s, kSPerp), 0.f, 1e-3f) << "scale " << s;
+  }
+  // Far from the seam the density is even and the weights near 1 (the jitter moves them):
+  // the centre stays at the point. (On an exactly flat patch the upper / lower split follows
+  // rounding, so the subsets' values are not compared.)
+  const std::size_t interior = nearest_to(plane, {-0.2f, 0.6f, 0.f});
+  for (int s = 0; s < 4; ++s) {
+    EXPECT_LT(by_area.at(interior, s, kSPar), 0.3f) << "scale " << s;
+    EXPECT_NEAR(by_area.at(interior, s, kSPar), by_count.at(interior, s, kSPar), 0.1f)
+        << "scale " << s;
+  }
+}
+
 TEST(Features, RightAngleCreaseSeparatesUpperAndLower) {
   std::mt19937 rng(3);
   PointCloud crease;  // an L: floor z = 0 (y >= 0) and wall y = 0 (z >= 0), crease on the x axis

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <tuple>
 
 #include "core/error.h"
 #include "edges/classifier.h"
@@ -153,19 +154,25 @@ TEST(ModelTest, ClassifyGivesEveryPointItsOwnFeaturesResult) {
     const float a = u(rng), b = u(rng);
     cloud.push_back(a, b, std::abs(a - 0.5f));  // a crease along a = 0.5
   }
-  ModelConfig config;
-  config.leaky_slope = 0.1f;
-  const Model model = random_model(config, 11);
-  const Classification fused = classify(cloud, model);
-  const Classification apart = classify_features(compute_features(cloud), model);
-  ASSERT_EQ(fused.labels.size(), cloud.size());
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    ASSERT_EQ(fused.labels[i], apart.labels[i]) << "point " << i;
-    ASSERT_NEAR(fused.p_sharp[i], apart.p_sharp[i], 1e-6f) << "point " << i;
-    ASSERT_NEAR(fused.p_boundary[i], apart.p_boundary[i], 1e-6f) << "point " << i;
+  // Also with the inputs the model's file names (area weights, angular gap).
+  for (const bool area_weights : {false, true}) {
+    ModelConfig config;
+    config.leaky_slope = 0.1f;
+    config.angular_gap = area_weights;
+    config.area_weights = area_weights;
+    const Model model = random_model(config, 11);
+    const Classification fused = classify(cloud, model);
+    const Classification apart =
+        classify_features(compute_features(cloud, config.feature_params()), model);
+    ASSERT_EQ(fused.labels.size(), cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      ASSERT_EQ(fused.labels[i], apart.labels[i]) << "point " << i;
+      ASSERT_NEAR(fused.p_sharp[i], apart.p_sharp[i], 1e-6f) << "point " << i;
+      ASSERT_NEAR(fused.p_boundary[i], apart.p_boundary[i], 1e-6f) << "point " << i;
+    }
+    EXPECT_GE(fused.features_s, 0.0);
+    EXPECT_GE(fused.inference_s, 0.0);
   }
-  EXPECT_GE(fused.features_s, 0.0);
-  EXPECT_GE(fused.inference_s, 0.0);
 }
 
 TEST(ModelTest, ZeroWeightsGiveTheSoftmaxOfTheOutputBias) {
@@ -231,23 +238,27 @@ TEST(ModelTest, PredictHandlesNoPointsAndRejectsOtherScaleCounts) {
 
 TEST(ModelTest, SaveLoadRoundTripIsExact) {
   TempDir dir;
-  for (const auto& [classes, angular_gap] :
-       {std::pair{3, false}, std::pair{2, false}, std::pair{3, true}}) {
+  for (const auto& [classes, angular_gap, area_weights] :
+       {std::tuple{3, false, false}, std::tuple{2, false, false}, std::tuple{3, true, false},
+        std::tuple{3, true, true}}) {
     ModelConfig config;
     config.classes = classes;
     config.angular_gap = angular_gap;
+    config.area_weights = area_weights;
     Model model = random_model(config, 11 + classes);
     model.input_std[5] = Model::kMinInputStd;
     model.layers[0].weights[0] = 1e-30f;           // tiny and
     model.layers[1].weights[3] = -3.40282347e38f;  // huge floats survive too
     model.training_info = {{"command", "glint edges train a.ply -o m.json"}, {"seed", 5}};
     const std::string path =
-        dir.file("model" + std::to_string(classes) + (angular_gap ? "gap" : "") + ".json");
+        dir.file("model" + std::to_string(classes) + (angular_gap ? "gap" : "") +
+                 (area_weights ? "area" : "") + ".json");
     model.save(path);
 
     const Model loaded = Model::load(path);
     EXPECT_EQ(loaded.config.classes, classes);
     EXPECT_EQ(loaded.config.angular_gap, angular_gap);
+    EXPECT_EQ(loaded.config.area_weights, area_weights);
     EXPECT_EQ(loaded.config.scales, config.scales);
     EXPECT_EQ(loaded.config.fusion_width, config.fusion_width);
     EXPECT_EQ(loaded.config.hidden, config.hidden);
@@ -264,6 +275,20 @@ TEST(ModelTest, SaveLoadRoundTripIsExact) {
     EXPECT_EQ(loaded.training_info, model.training_info);
     EXPECT_EQ(loaded.parameter_count(), model.parameter_count());
   }
+}
+
+// Model files written before area weights existed have no "neighbour_weights": they load as
+// counts, the neighbours weighing 1.
+TEST(ModelTest, FilesWithoutNeighbourWeightsCountNeighbours) {
+  TempDir dir;
+  ModelConfig config;
+  config.area_weights = true;
+  nlohmann::json json = random_model(config, 5).to_json();
+  EXPECT_EQ(json["neighbour_weights"], "area");
+  json.erase("neighbour_weights");
+  const std::string path = dir.file("older.json");
+  std::ofstream(path) << json.dump();
+  EXPECT_FALSE(Model::load(path).config.area_weights);
 }
 
 // Writes `json` to a file, lets `damage` change it first, and expects load() to name the key.
@@ -319,6 +344,9 @@ TEST_F(MalformedModelTest, WrongValues) {
   expect_rejected([](nlohmann::json& j) { j["version"] = 2; }, "version");
   expect_rejected([](nlohmann::json& j) { j["classes"] = {"a", "b", "c"}; }, "classes");
   expect_rejected([](nlohmann::json& j) { j["training"] = 3; }, "training");
+  expect_rejected([](nlohmann::json& j) { j["neighbour_weights"] = "density"; },
+                  "neighbour_weights");
+  expect_rejected([](nlohmann::json& j) { j["neighbour_weights"] = 1; }, "neighbour_weights");
 }
 
 TEST_F(MalformedModelTest, BrokenNoiseGates) {

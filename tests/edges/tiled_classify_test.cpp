@@ -159,6 +159,30 @@ TEST_F(TiledClassify, TilesGiveTheWholeCloudsLabelsPointForPoint) {
   EXPECT_EQ(out.get<std::uint8_t>("scalar_label")->size(), whole.points);
 }
 
+// With area weights the neighbours' own spacings count too: the tiles' wider halos still give
+// every point the whole cloud's label.
+TEST_F(TiledClassify, AreaWeightedTilesGiveTheWholeCloudsLabels) {
+  const double origin[3] = {0, 0, 0};
+  write_scene(path("scene.las"), origin);
+  Model model = bounded_model();
+  model.config.area_weights = true;
+  const TiledClassifyStats whole = classify_las(path("scene.las"), path("whole.las"), model);
+  TiledClassifyParams params;
+  params.tile_points = 13500;  // of 14,063: the threefold halos need large tiles
+  const TiledClassifyStats tiled =
+      classify_las(path("scene.las"), path("tiled.las"), model, params);
+  EXPECT_TRUE(tiled.tiled);
+  EXPECT_GE(tiled.tiles, 2u);
+  const OutputDifference difference = compare_outputs(path("whole.las"), path("tiled.las"));
+  EXPECT_TRUE(difference.other_bytes_equal);
+  EXPECT_EQ(difference.labels, 0u);
+  EXPECT_LT(difference.largest_probability, 0.05f);
+  // The halos reach three times as far as the counting model's (the bound above).
+  const TiledClassifyStats counted =
+      classify_las(path("scene.las"), path("counted.las"), bounded_model(), params);
+  EXPECT_GT(tiled.halo_points, counted.halo_points);
+}
+
 // A noise-gated model chooses one network for the whole file: in tiles the same one, from the
 // quiet points of every tile's core, as for the cloud at once.
 TEST_F(TiledClassify, AGatedModelChoosesOneNetworkForTheWholeFileInTilesToo) {
