@@ -59,6 +59,19 @@ for seed in $SEEDS; do
   wait
 done
 
+# With AREA_WEIGHTS=1 also both models with area-weighted neighbourhoods (--area-weights,
+# docs/decisions.md "Area-weighted neighbourhoods: built, not shipped"), seeds 1, 2 and 3, for
+# scripts/eval-bounded-cad.sh; they are not candidates of the selection below.
+if [[ ${AREA_WEIGHTS:-0} == 1 ]]; then
+  for seed in $SEEDS; do
+    [[ -f "$WORK/models/bounded-3c-area-s$seed.json" ]] ||
+      train "bounded-3c-area-s$seed" 3 "$seed" "$NOTES" "${DATA_3C[@]}" --area-weights &
+    [[ -f "$WORK/models/bounded-2c-area-s$seed.json" ]] ||
+      train "bounded-2c-area-s$seed" 2 "$seed" "$NOTES" "${DATA_2C[@]}" --area-weights &
+    wait
+  done
+fi
+
 # The low-noise networks of the noise gate: the clean CAD parts alone (noise 0; the bazazian
 # clouds are left out, docs/decisions.md "The noise gate: built, not shipped").
 mapfile -t CLEAN < <(/usr/bin/python3 -c '
