@@ -257,7 +257,8 @@ const float* area_weights(const geometry::Neighbourhood& nb, const float* square
 template <bool kAreaWeights>
 void point_features(const geometry::Neighbourhood& nb, const FeatureParams& params,
                     const float* squared_spacings, Scratch& scratch, float* row) {
-  const float* weights = kAreaWeights ? area_weights(nb, squared_spacings, scratch) : nullptr;
+  const float* weights = nullptr;
+  if constexpr (kAreaWeights) weights = area_weights(nb, squared_spacings, scratch);
   const auto weight = [weights](int j) {
     if constexpr (kAreaWeights) return weights[j];
     return 1.f;
