@@ -6,7 +6,6 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <tuple>
 
 #include "cli_support.h"
 #include "commands.h"
@@ -115,11 +114,9 @@ void run_eval(EvalOptions options) {
     try {
       // Models with the same scales and inputs share one feature matrix (features dominate
       // the time).
-      std::map<std::tuple<std::vector<int>, bool, bool>, std::pair<edges::FeatureMatrix, double>>
-          features_by_inputs;
+      std::map<edges::FeatureParams, std::pair<edges::FeatureMatrix, double>> features_by_inputs;
       for (const auto& [method, model] : models) {
-        auto [entry, is_new] = features_by_inputs.try_emplace(
-            {model.config.scales, model.config.angular_gap, model.config.area_weights});
+        auto [entry, is_new] = features_by_inputs.try_emplace(model.config.feature_params());
         auto& [features, features_s] = entry->second;
         if (is_new) {
           const Stopwatch watch;

@@ -44,10 +44,8 @@ std::vector<Classification> run_networks(const PointCloud& cloud,
                                          const std::vector<const Model*>& networks,
                                          const std::vector<int>& scales, float threshold,
                                          std::vector<std::uint8_t>* quiet) {
-  FeatureParams params;
+  FeatureParams params = networks.front()->config.feature_params();
   params.scales = scales;
-  params.angular_gap = networks.front()->config.angular_gap;
-  params.area_weights = networks.front()->config.area_weights;
   const int scale_count = static_cast<int>(scales.size());
   const int per_scale = params.per_scale();
   const std::size_t row_size = params.row_size();

@@ -434,7 +434,7 @@ void compute_rows(const PointCloud& cloud, const FeatureParams& params,
   const PointKernel kernel = point_kernel();
   const std::vector<float> spacings =
       params.area_weights ? squared_spacings(cloud) : std::vector<float>();
-  const float* spacing_of = params.area_weights ? spacings.data() : nullptr;
+  const float* spacing_of = spacings.empty() ? nullptr : spacings.data();
   geometry::NeighbourhoodParams search;
   search.k = params.scales[0];
   ProgressBar progress("features", cloud.size());

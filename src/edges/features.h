@@ -30,6 +30,7 @@
 // so that s_perp >= 0, i.e. the query point lies in the upper half-space. This makes convex
 // and concave creases look alike and removes the sign ambiguity of the eigenvector.
 // An empty subset contributes zeros.
+#include <compare>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -59,6 +60,8 @@ struct FeatureParams {
   bool area_weights = false;  // neighbours weighed by the surface they stand for
   int per_scale() const { return features_per_scale(angular_gap); }
   std::size_t row_size() const { return scales.size() * std::size_t(per_scale()); }
+  // Equal params give equal features (models may share one feature matrix).
+  auto operator<=>(const FeatureParams&) const = default;
 };
 
 // Row-major features: value(point, scale, feature) at

@@ -139,9 +139,8 @@ void Model::check() const {
   }
   if (gated()) {
     if (low_noise->gated()) throw Error(where, "noise_gate", "the gate's network has a gate");
-    if (low_noise->config.classes != config.classes || low_noise->config.scales != config.scales ||
-        low_noise->config.angular_gap != config.angular_gap ||
-        low_noise->config.area_weights != config.area_weights ||
+    if (low_noise->config.classes != config.classes ||
+        low_noise->config.feature_params() != config.feature_params() ||
         low_noise->layers.size() != layers.size())
       throw Error(where, "noise_gate.low_noise",
                   "the gate's network must have the same classes, scales, inputs and layers");
@@ -268,7 +267,7 @@ Model Model::load(const std::string& path) {
 
   ModelConfig config;
   config.angular_gap = features == features_per_scale(true);
-  // Files written before area weights existed have no key: their neighbours weigh 1.
+  // The key is optional: without it (files of earlier versions) neighbours weigh 1.
   if (root.contains("neighbour_weights")) {
     const std::string weights = reader.string(root, "neighbour_weights");
     if (weights != "count" && weights != "area")

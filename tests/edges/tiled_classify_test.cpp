@@ -166,7 +166,7 @@ TEST_F(TiledClassify, AreaWeightedTilesGiveTheWholeCloudsLabels) {
   write_scene(path("scene.las"), origin);
   Model model = bounded_model();
   model.config.area_weights = true;
-  const TiledClassifyStats whole = classify_las(path("scene.las"), path("whole.las"), model);
+  classify_las(path("scene.las"), path("whole.las"), model);
   TiledClassifyParams params;
   params.tile_points = 13500;  // of 14,063: the threefold halos need large tiles
   const TiledClassifyStats tiled =
