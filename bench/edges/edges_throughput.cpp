@@ -1,7 +1,7 @@
 // End-to-end BoundED throughput: features (kNN included) and classification of a generated
-// N-point cloud with the peak memory, the neighbour search alone, the rate of plain nanoflann
-// k-d tree queries at the largest scale (k = 128) on the same cloud, and the time for every
-// cloud of a folder (default: default-eval).
+// N-point cloud with the peak memory, the neighbour search alone (and an area-weighted model's
+// spacing pass alone), the rate of plain nanoflann k-d tree queries at the largest scale
+// (k = 128) on the same cloud, and the time for every cloud of a folder (default: default-eval).
 // Writes JSON (stdout, or --json FILE) with the machine and the parameters it ran with.
 //
 //   edges_throughput [--points 1000000] [--model models/bounded-3c.json] [--data DIR] [--json F]
@@ -22,6 +22,7 @@
 #include "core/timer.h"
 #include "edges/classifier.h"
 #include "edges/covariance_baseline.h"
+#include "edges/features.h"
 #include "edges/model.h"
 #include "edges/synth.h"
 #include "geometry/kdtree.h"
@@ -79,7 +80,7 @@ int main(int argc, char** argv) {
 
   const glint::PointCloud cloud = benchmark_cloud(points);
   const double rss_before_mib = glint::bench::peak_rss_mib();
-  std::vector<double> features_runs, inference_runs, total_runs, search_runs;
+  std::vector<double> features_runs, inference_runs, total_runs, search_runs, spacing_runs;
   for (int run = 0; run < repeat; ++run) {
     const glint::edges::Classification result = glint::edges::classify(cloud, model);
     features_runs.push_back(result.features_s);
@@ -96,6 +97,14 @@ int main(int argc, char** argv) {
       checksum.fetch_add(neighbourhood.indices[neighbourhood.size - 1], std::memory_order_relaxed);
     });
     search_runs.push_back(search_watch.elapsed_s());
+
+    // An area-weighted model's spacing pass alone on the search's grid (part of features_s).
+    if (model.config.area_weights) {
+      const glint::geometry::NeighbourhoodSearch grid(cloud, search);
+      const glint::Stopwatch spacing_watch;
+      grid.kth_nearest_squared_distances(glint::edges::kAreaSpacingNeighbour + 1);
+      spacing_runs.push_back(spacing_watch.elapsed_s());
+    }
   }
   const double total_s = median(total_runs);
   report["generated"] = {{"points", points},
@@ -108,6 +117,10 @@ int main(int argc, char** argv) {
                          {"search_only_s_runs", search_runs},
                          {"peak_rss_mib", glint::bench::peak_rss_mib()},
                          {"peak_rss_before_features_mib", rss_before_mib}};
+  if (!spacing_runs.empty()) {
+    report["generated"]["spacings_only_s"] = median(spacing_runs);
+    report["generated"]["spacings_only_s_runs"] = spacing_runs;
+  }
 
   const glint::Stopwatch watch;
   glint::edges::classify_covariance_baseline(cloud);

@@ -244,9 +244,9 @@ const float* area_weights(const geometry::Neighbourhood& nb, const float* square
   float* weights = scratch.weights.data();
   // A query with duplicates closer than its spacing neighbour has spacing 0: the clamp decides.
   const float query = std::max(squared_spacings[nb.point], std::numeric_limits<float>::min());
+  // The neighbours' spacings come with the neighbourhood (nb.values).
   for (int j = 0; j < nb.size; ++j)
-    weights[j] =
-        std::clamp(squared_spacings[nb.indices[j]] / query, 1.0f / kMaxAreaWeight, kMaxAreaWeight);
+    weights[j] = std::clamp(nb.values[j] / query, 1.0f / kMaxAreaWeight, kMaxAreaWeight);
   return weights;
 }
 
@@ -408,21 +408,12 @@ void check_cloud(const PointCloud& cloud, const FeatureParams& params) {
 
 // Every point's squared distance to its kAreaSpacingNeighbour-th nearest other point (or the
 // farthest, in a smaller cloud): the area it stands for, up to a constant.
-std::vector<float> squared_spacings(const PointCloud& cloud) {
-  std::vector<float> spacings(cloud.size());
-  geometry::NeighbourhoodParams search;
-  search.k =
+std::vector<float> squared_spacings(const PointCloud& cloud,
+                                    const geometry::NeighbourhoodSearch& search) {
+  const int k =
       static_cast<int>(std::min(cloud.size(), static_cast<std::size_t>(kAreaSpacingNeighbour + 1)));
   ProgressBar progress("spacings", cloud.size());
-  geometry::for_each_neighbourhood(
-      cloud, search,
-      [&](const geometry::Neighbourhood& nb) {
-        const int last = nb.size - 1;
-        spacings[nb.point] =
-            nb.dx[last] * nb.dx[last] + nb.dy[last] * nb.dy[last] + nb.dz[last] * nb.dz[last];
-      },
-      [&](std::size_t done) { progress.advance(done); });
-  return spacings;
+  return search.kth_nearest_squared_distances(k, [&](std::size_t done) { progress.advance(done); });
 }
 
 // Every point's features, written to row_for(point, scratch); row_written(scratch) follows
@@ -432,20 +423,20 @@ void compute_rows(const PointCloud& cloud, const FeatureParams& params,
                   tbb::enumerable_thread_specific<Scratch>& scratches, RowFor&& row_for,
                   RowWritten&& row_written) {
   const PointKernel kernel = point_kernel();
+  geometry::NeighbourhoodParams search_params;
+  search_params.k = params.scales[0];
+  const geometry::NeighbourhoodSearch search(cloud, search_params);
   const std::vector<float> spacings =
-      params.area_weights ? squared_spacings(cloud) : std::vector<float>();
+      params.area_weights ? squared_spacings(cloud, search) : std::vector<float>();
   const float* spacing_of = spacings.empty() ? nullptr : spacings.data();
-  geometry::NeighbourhoodParams search;
-  search.k = params.scales[0];
   ProgressBar progress("features", cloud.size());
-  const geometry::NeighbourhoodStats stats = geometry::for_each_neighbourhood(
-      cloud, search,
+  const geometry::NeighbourhoodStats stats = search.for_each(
       [&](const geometry::Neighbourhood& nb) {
         Scratch& scratch = scratches.local();
         kernel(nb, params, spacing_of, scratch, row_for(nb.point, scratch));
         row_written(scratch);
       },
-      [&](std::size_t done) { progress.advance(done); });
+      [&](std::size_t done) { progress.advance(done); }, spacings);
   log().debug(
       "neighbourhoods: {} points, {} grid cells of {:.4g}, {} queries retried on a larger "
       "block, {} answered by the k-d tree",

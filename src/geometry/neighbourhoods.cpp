@@ -14,6 +14,7 @@
 #include <limits>
 #include <mutex>
 #include <random>
+#include <span>
 #include <string>
 #include <utility>
 
@@ -84,10 +85,10 @@ double quantile(std::vector<double> values, double q) {
   return values[at];
 }
 
-// Grid cell size: a high quantile of the k-th neighbour distance (from a k-d tree over a
-// subsample whose neighbour count is scaled by the sampling rate, surface-like density
-// assumed) divided by kBlockRadius.
-double estimate_cell_size(const PointCloud& cloud, int k) {
+// A high quantile of the k-th neighbour distance, from a k-d tree over a subsample whose
+// neighbour count is scaled by the sampling rate (surface-like density assumed); the grid cells
+// are sized from it.
+double high_kth_distance(const PointCloud& cloud, int k) {
   const std::size_t n = cloud.size();
   const std::size_t m = std::min<std::size_t>(n, std::max<std::size_t>(20000, n / 8));
   // A seeded random subsample: a fixed stride could alias with the file's point order.
@@ -115,7 +116,7 @@ double estimate_cell_size(const PointCloud& cloud, int k) {
     const int found = tree.knn(point, k_sample, indices.data(), distances.data());
     radii[q] = std::sqrt(double(distances[found - 1])) * correction;
   });
-  return quantile(std::move(radii), 0.9) / kBlockRadius;
+  return quantile(std::move(radii), 0.9);
 }
 
 Grid build_grid(const PointCloud& cloud, double cell_size) {
@@ -200,6 +201,7 @@ Grid build_grid(const PointCloud& cloud, double cell_size) {
 struct Scratch {
   std::vector<float> cx, cy, cz;      // gathered candidates
   std::vector<std::uint32_t> cindex;  // their index in the cloud
+  std::vector<float> cvalue;          // their value, when for_each carries values
   std::vector<float> distances;       // squared distance of each candidate to the query
   std::vector<std::uint64_t> ranked;  // (squared distance bits << 32) | candidate
   float previous_kth = 0;             // k-th squared distance of the previous query
@@ -214,18 +216,21 @@ struct Scratch {
   std::array<std::uint32_t, kBucketsAvx512> bucket_start{};
   std::vector<float> dx, dy, dz;  // accepted neighbourhood, relative to the query
   std::vector<std::uint32_t> indices;
+  std::vector<float> values;         // and its values, when carried
   std::vector<std::uint32_t> retry;  // sorted slots that need a larger block
   std::vector<float> fallback_distances;
 };
 
-// Candidate block of `radius` cells around a cell: gathers its points and returns the block's
-// bounds (infinite on sides where the grid ends, since nothing lies beyond).
+// Candidate block of `radius` cells around a cell: gathers its points (and their entries of
+// slot_values, a value per sorted slot, when given) and returns the block's bounds (infinite
+// on sides where the grid ends, since nothing lies beyond).
 void gather_block(const Grid& grid, std::size_t cell, int radius, Scratch& scratch, double lower[3],
-                  double upper[3]) {
+                  double upper[3], const float* slot_values = nullptr) {
   scratch.cx.clear();
   scratch.cy.clear();
   scratch.cz.clear();
   scratch.cindex.clear();
+  scratch.cvalue.clear();
   const auto rows = static_cast<std::uint64_t>(grid.dims[1]);
   const std::int64_t c[3] = {static_cast<std::int64_t>(grid.cell_column[cell] / rows),
                              static_cast<std::int64_t>(grid.cell_column[cell] % rows),
@@ -255,8 +260,18 @@ void gather_block(const Grid& grid, std::size_t cell, int radius, Scratch& scrat
       scratch.cz.insert(scratch.cz.end(), grid.zs.begin() + begin, grid.zs.begin() + end);
       scratch.cindex.insert(scratch.cindex.end(), grid.original.begin() + begin,
                             grid.original.begin() + end);
+      if (slot_values)
+        scratch.cvalue.insert(scratch.cvalue.end(), slot_values + begin, slot_values + end);
     }
   }
+}
+
+// Distance from a query to the nearest side of its candidate block: nothing outside the block
+// is nearer.
+inline double guaranteed_radius(float qx, float qy, float qz, const double lower[3],
+                                const double upper[3]) {
+  return std::min(
+      {qx - lower[0], upper[0] - qx, qy - lower[1], upper[1] - qy, qz - lower[2], upper[2] - qz});
 }
 
 // Sort key of a candidate: squared distance bits (monotone for non-negative floats) above the
@@ -389,8 +404,7 @@ bool select_from_block(const Grid& grid, std::uint32_t slot, const double lower[
   const std::size_t count = scratch.cx.size();
   if (count < static_cast<std::size_t>(k)) return false;
   const float qx = grid.xs[slot], qy = grid.ys[slot], qz = grid.zs[slot];
-  const double guaranteed = std::min(
-      {qx - lower[0], upper[0] - qx, qy - lower[1], upper[1] - qy, qz - lower[2], upper[2] - qz});
+  const double guaranteed = guaranteed_radius(qx, qy, qz, lower, upper);
   scratch.distances.resize(count);
   scratch.ranked.resize(count);
   const float* cx = scratch.cx.data();
@@ -426,6 +440,9 @@ bool select_from_block(const Grid& grid, std::uint32_t slot, const double lower[
     scratch.dz[j] = cz[candidate] - qz;
     scratch.indices[j] = scratch.cindex[candidate];
   }
+  if (!scratch.cvalue.empty())
+    for (int j = 0; j < k; ++j)
+      scratch.values[j] = scratch.cvalue[static_cast<std::uint32_t>(ranked[j])];
   return true;
 }
 
@@ -463,10 +480,22 @@ SelectKernel select_kernel() {
 
 }  // namespace
 
-NeighbourhoodStats for_each_neighbourhood(const PointCloud& cloud,
-                                          const NeighbourhoodParams& params,
-                                          const std::function<void(const Neighbourhood&)>& visit,
-                                          const std::function<void(std::size_t)>& progress) {
+struct NeighbourhoodSearch::State {
+  const PointCloud& cloud;
+  int k;
+  Grid grid;
+  std::once_flag tree_built;
+  std::unique_ptr<KdTree> tree;
+
+  // For the sparse regions and outliers that no block answers; built on first use.
+  const KdTree& kd_tree() {
+    std::call_once(tree_built, [&] { tree = std::make_unique<KdTree>(cloud); });
+    return *tree;
+  }
+};
+
+NeighbourhoodSearch::NeighbourhoodSearch(const PointCloud& cloud,
+                                         const NeighbourhoodParams& params) {
   const int k = params.k;
   if (k < 1) throw Error("", "neighbourhood search", "k must be at least 1");
   if (cloud.size() < static_cast<std::size_t>(k)) {
@@ -474,16 +503,35 @@ NeighbourhoodStats for_each_neighbourhood(const PointCloud& cloud,
                 "the cloud has " + std::to_string(cloud.size()) +
                     " points, fewer than k = " + std::to_string(k));
   }
+  const double cell =
+      params.cell_size > 0 ? params.cell_size : high_kth_distance(cloud, k) / kBlockRadius;
+  state_.reset(new State{cloud, k, build_grid(cloud, cell), {}, {}});
+}
 
+NeighbourhoodSearch::~NeighbourhoodSearch() = default;
+
+NeighbourhoodStats NeighbourhoodSearch::for_each(
+    const std::function<void(const Neighbourhood&)>& visit,
+    const std::function<void(std::size_t)>& progress, std::span<const float> values) const {
+  const int k = state_->k;
+  const Grid& grid = state_->grid;
+  const std::size_t n = grid.original.size();
+  if (!values.empty() && values.size() != n) {
+    throw Error(
+        "", "neighbourhood search",
+        "has " + std::to_string(values.size()) + " values for " + std::to_string(n) + " points");
+  }
+  // In slot order, so that a block's values are gathered with its positions (neighbours' values
+  // looked up by cloud index would be cache misses).
+  std::vector<float> slot_values(values.size());
+  parallel_for(slot_values.size(),
+               [&](std::size_t slot) { slot_values[slot] = values[grid.original[slot]]; });
+  const float* carried = values.empty() ? nullptr : slot_values.data();
   NeighbourhoodStats stats;
-  const double cell = params.cell_size > 0 ? params.cell_size : estimate_cell_size(cloud, k);
-  const Grid grid = build_grid(cloud, cell);
   stats.cell_size = grid.cell;
   stats.cells = grid.cell_begin.size() - 1;
 
   const SelectKernel select = select_kernel();
-  std::once_flag tree_built;
-  std::unique_ptr<KdTree> tree;
   std::atomic<std::size_t> retried{0}, fallbacks{0};
   tbb::enumerable_thread_specific<Scratch> scratches([k] {
     Scratch s;
@@ -491,6 +539,7 @@ NeighbourhoodStats for_each_neighbourhood(const PointCloud& cloud,
     s.dy.resize(k);
     s.dz.resize(k);
     s.indices.resize(k);
+    s.values.resize(k);
     s.fallback_distances.resize(k);
     return s;
   });
@@ -503,6 +552,7 @@ NeighbourhoodStats for_each_neighbourhood(const PointCloud& cloud,
     neighbourhood.dy = scratch.dy.data();
     neighbourhood.dz = scratch.dz.data();
     neighbourhood.indices = scratch.indices.data();
+    neighbourhood.values = carried ? scratch.values.data() : nullptr;
     visit(neighbourhood);
   };
 
@@ -513,7 +563,7 @@ NeighbourhoodStats for_each_neighbourhood(const PointCloud& cloud,
     for (std::size_t cell_id = first_cell; cell_id < end_cell; ++cell_id) {
       const std::uint32_t begin = grid.cell_begin[cell_id], end = grid.cell_begin[cell_id + 1];
       scratch.retry.clear();
-      gather_block(grid, cell_id, kBlockRadius, scratch, lower, upper);
+      gather_block(grid, cell_id, kBlockRadius, scratch, lower, upper, carried);
       for (std::uint32_t slot = begin; slot < end; ++slot) {
         if (select(grid, slot, lower, upper, k, scratch)) {
           emit(slot, scratch);
@@ -523,19 +573,20 @@ NeighbourhoodStats for_each_neighbourhood(const PointCloud& cloud,
       }
       if (!scratch.retry.empty()) {
         retried += scratch.retry.size();
-        gather_block(grid, cell_id, kRetryBlockRadius, scratch, lower, upper);
+        gather_block(grid, cell_id, kRetryBlockRadius, scratch, lower, upper, carried);
         for (const std::uint32_t slot : scratch.retry) {
           if (!select(grid, slot, lower, upper, k, scratch)) {
             // Sparse region or outlier: exact k-d tree query, already sorted by distance.
-            std::call_once(tree_built, [&] { tree = std::make_unique<KdTree>(cloud); });
             ++fallbacks;
             const float query[3] = {grid.xs[slot], grid.ys[slot], grid.zs[slot]};
-            tree->knn(query, k, scratch.indices.data(), scratch.fallback_distances.data());
+            state_->kd_tree().knn(query, k, scratch.indices.data(),
+                                  scratch.fallback_distances.data());
             for (int j = 0; j < k; ++j) {
               const std::uint32_t i = scratch.indices[j];
-              scratch.dx[j] = cloud.x[i] - query[0];
-              scratch.dy[j] = cloud.y[i] - query[1];
-              scratch.dz[j] = cloud.z[i] - query[2];
+              scratch.dx[j] = state_->cloud.x[i] - query[0];
+              scratch.dy[j] = state_->cloud.y[i] - query[1];
+              scratch.dz[j] = state_->cloud.z[i] - query[2];
+              if (carried) scratch.values[j] = values[i];
             }
           }
           emit(slot, scratch);
@@ -548,6 +599,177 @@ NeighbourhoodStats for_each_neighbourhood(const PointCloud& cloud,
   stats.retried_queries = retried;
   stats.fallback_queries = fallbacks;
   return stats;
+}
+
+namespace {
+
+// Squared distances from (qx, qy, qz) to the gathered candidates. Never inlined into a kernel
+// built for a later instruction set: fused multiply-adds would round them differently from
+// a visitor's dx² + dy² + dz².
+[[gnu::noinline]] void candidate_squared_distances(float qx, float qy, float qz, Scratch& scratch) {
+  const std::size_t count = scratch.cx.size();
+  scratch.distances.resize(count);
+  const float* cx = scratch.cx.data();
+  const float* cy = scratch.cy.data();
+  const float* cz = scratch.cz.data();
+  float* distances = scratch.distances.data();
+  for (std::size_t j = 0; j < count; ++j) {
+    const float ex = cx[j] - qx, ey = cy[j] - qy, ez = cz[j] - qz;
+    distances[j] = ex * ex + ey * ey + ez * ez;
+  }
+}
+
+// Pools up to this size are ranked by counting, larger ones by nth_element.
+constexpr std::size_t kRankedPool = 32;
+
+// The k-th smallest of values[0, n): the value with fewer than k smaller and at least k not
+// larger, found by counting for every value (branch-free, in vector lanes).
+inline float kth_smallest_by_counting(const float* values, std::size_t n, int k) {
+  float kth = values[0];
+  for (std::size_t i = 0; i < n; ++i) {
+    const float v = values[i];
+    int less = 0, not_larger = 0;
+    for (std::size_t j = 0; j < n; ++j) {
+      less += values[j] < v;
+      not_larger += values[j] <= v;
+    }
+    kth = less < k && not_larger >= k ? v : kth;
+  }
+  return kth;
+}
+
+// The k-th smallest squared distance from (qx, qy, qz) to the gathered candidates (infinite
+// when there are fewer than k). Neighbouring queries have similar k-th distances: the
+// candidates within a margin of the previous one are compacted and ranked (all of them only
+// when fewer than k are kept), where the bucket sort above is laid out for k ~ 128.
+template <bool kAvx512>
+float kth_candidate_distance(float qx, float qy, float qz, int k, Scratch& scratch) {
+  const std::size_t count = scratch.cx.size();
+  if (count < static_cast<std::size_t>(k)) return kInfinity;
+  candidate_squared_distances(qx, qy, qz, scratch);
+  float* pool = scratch.distances.data();
+  std::size_t pooled = count;
+  // A margin that keeps too few is widened once before the whole block is ranked.
+  for (const float margin : {1.5f, 6.0f}) {
+    if (!(scratch.previous_kth > 0)) break;
+    scratch.within.resize(count + kCompactLanes);
+    scratch.within_distance.resize(count + kCompactLanes);
+    const float limit = scratch.previous_kth * margin;
+    std::size_t kept = 0, scanned = 0;
+#if defined(__x86_64__)
+    if constexpr (kAvx512)
+      kept = compact_steps_avx512(pool, count, limit, scratch.within.data(),
+                                  scratch.within_distance.data(), scanned);
+#endif
+    kept = compact_within(pool, scanned, count, limit, scratch.within.data(),
+                          scratch.within_distance.data(), kept);
+    if (kept >= static_cast<std::size_t>(k)) {
+      pool = scratch.within_distance.data(), pooled = kept;
+      break;
+    }
+  }
+  float kth;
+  if (pooled <= kRankedPool) {
+    kth = kth_smallest_by_counting(pool, pooled, k);
+  } else {
+    std::nth_element(pool, pool + (k - 1), pool + pooled);
+    kth = pool[k - 1];
+  }
+  scratch.previous_kth = kth;
+  return kth;
+}
+
+using KthKernel = float (*)(float, float, float, int, Scratch&);
+
+[[gnu::flatten]] float kth_candidate_distance_baseline(float qx, float qy, float qz, int k,
+                                                       Scratch& scratch) {
+  return kth_candidate_distance<false>(qx, qy, qz, k, scratch);
+}
+#if defined(__x86_64__)
+// The same with the AVX-512 compaction and counting in sixteen lanes (the distances stay
+// baseline code, see candidate_squared_distances).
+[[gnu::target("arch=x86-64-v4"), gnu::flatten]] float kth_candidate_distance_x86_64_v4(
+    float qx, float qy, float qz, int k, Scratch& scratch) {
+  return kth_candidate_distance<true>(qx, qy, qz, k, scratch);
+}
+#endif
+
+KthKernel kth_kernel() {
+#if defined(__x86_64__)
+  if (cpu_has_x86_64_v4()) return kth_candidate_distance_x86_64_v4;
+#endif
+  return kth_candidate_distance_baseline;
+}
+
+}  // namespace
+
+std::vector<float> NeighbourhoodSearch::kth_nearest_squared_distances(
+    int k, const std::function<void(std::size_t)>& progress) const {
+  const PointCloud& cloud = state_->cloud;
+  const Grid& grid = state_->grid;
+  if (k < 1 || k > kMaxSmallK) {
+    throw Error("", "k-th neighbour distances",
+                "k must be between 1 and " + std::to_string(kMaxSmallK));
+  }
+  if (cloud.size() < static_cast<std::size_t>(k)) {
+    throw Error("", "k-th neighbour distances",
+                "the cloud has " + std::to_string(cloud.size()) +
+                    " points, fewer than k = " + std::to_string(k));
+  }
+  const std::size_t cells = grid.cell_begin.size() - 1;
+  const KthKernel kth_candidate_distance = kth_kernel();
+  std::vector<float> result(cloud.size());
+  tbb::enumerable_thread_specific<Scratch> scratches;
+  parallel_for_chunks(cells, 16, [&](std::size_t first_cell, std::size_t end_cell) {
+    Scratch& scratch = scratches.local();
+    double lower[3], upper[3];
+    for (std::size_t cell_id = first_cell; cell_id < end_cell; ++cell_id) {
+      const std::uint32_t begin = grid.cell_begin[cell_id], end = grid.cell_begin[cell_id + 1];
+      scratch.retry.clear();
+      // The cells are sized for the larger k, so one cell around usually holds the k nearest.
+      gather_block(grid, cell_id, 1, scratch, lower, upper);
+      for (std::uint32_t slot = begin; slot < end; ++slot) {
+        const float qx = grid.xs[slot], qy = grid.ys[slot], qz = grid.zs[slot];
+        const float kth = kth_candidate_distance(qx, qy, qz, k, scratch);
+        const double guaranteed = guaranteed_radius(qx, qy, qz, lower, upper);
+        if (double(kth) <= guaranteed * guaranteed * (1.0 - 1e-6))
+          result[grid.original[slot]] = kth;
+        else
+          scratch.retry.push_back(slot);
+      }
+      if (scratch.retry.empty()) continue;
+      gather_block(grid, cell_id, kBlockRadius, scratch, lower, upper);
+      for (const std::uint32_t slot : scratch.retry) {
+        const float qx = grid.xs[slot], qy = grid.ys[slot], qz = grid.zs[slot];
+        float kth = kth_candidate_distance(qx, qy, qz, k, scratch);
+        const double guaranteed = guaranteed_radius(qx, qy, qz, lower, upper);
+        if (double(kth) > guaranteed * guaranteed * (1.0 - 1e-6)) {
+          // Sparse region or outlier: exact k-d tree query; the distance recomputed as above.
+          const float query[3] = {qx, qy, qz};
+          scratch.indices.resize(k);
+          scratch.fallback_distances.resize(k);
+          state_->kd_tree().knn(query, k, scratch.indices.data(),
+                                scratch.fallback_distances.data());
+          kth = 0;
+          for (int j = 0; j < k; ++j) {
+            const std::uint32_t i = scratch.indices[j];
+            const float ex = cloud.x[i] - qx, ey = cloud.y[i] - qy, ez = cloud.z[i] - qz;
+            kth = std::max(kth, ex * ex + ey * ey + ez * ez);
+          }
+        }
+        result[grid.original[slot]] = kth;
+      }
+    }
+    if (progress) progress(grid.cell_begin[end_cell] - grid.cell_begin[first_cell]);
+  });
+  return result;
+}
+
+NeighbourhoodStats for_each_neighbourhood(const PointCloud& cloud,
+                                          const NeighbourhoodParams& params,
+                                          const std::function<void(const Neighbourhood&)>& visit,
+                                          const std::function<void(std::size_t)>& progress) {
+  return NeighbourhoodSearch(cloud, params).for_each(visit, progress);
 }
 
 }  // namespace glint::geometry

@@ -12,6 +12,8 @@
 // and then fall back to a k-d tree. Lists are handed to the visitor and never all stored.
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <span>
 #include <vector>
 
 #include "core/point_cloud.h"
@@ -28,6 +30,7 @@ struct Neighbourhood {
   const float* dy = nullptr;
   const float* dz = nullptr;
   const std::uint32_t* indices = nullptr;  // neighbour indices in the cloud
+  const float* values = nullptr;  // neighbours' entries of the values given to for_each, or null
 };
 
 struct NeighbourhoodParams {
@@ -44,10 +47,44 @@ struct NeighbourhoodStats {
   std::size_t fallback_queries = 0;  // needed the k-d tree
 };
 
-// Calls visit(neighbourhood) once for every point, from several threads at once (the visitor
-// must be thread-safe; the Neighbourhood's arrays are valid only during the call).
-// progress(points_done) is called now and then from worker threads (may be empty).
-// Throws glint::Error when the cloud has fewer points than k or k < 1.
+// The largest k for NeighbourhoodSearch::kth_nearest_squared_distances.
+inline constexpr int kMaxSmallK = 32;
+
+// A cloud bucketed once for exact neighbourhoods of params.k points; the same grid also
+// answers a smaller k, so a pass that needs both builds it once.
+class NeighbourhoodSearch {
+ public:
+  // Keeps a reference to the cloud. Throws glint::Error when the cloud has fewer points than
+  // params.k or params.k < 1.
+  NeighbourhoodSearch(const PointCloud& cloud, const NeighbourhoodParams& params);
+  ~NeighbourhoodSearch();
+  NeighbourhoodSearch(const NeighbourhoodSearch&) = delete;
+  NeighbourhoodSearch& operator=(const NeighbourhoodSearch&) = delete;
+
+  // Calls visit(neighbourhood) once for every point, from several threads at once (the visitor
+  // must be thread-safe; the Neighbourhood's arrays are valid only during the call).
+  // progress(points_done) is called now and then from worker threads (may be empty).
+  // values, one per point when given, are handed out per neighbour (Neighbourhood::values),
+  // gathered with the positions. Throws glint::Error when values has another size.
+  NeighbourhoodStats for_each(const std::function<void(const Neighbourhood&)>& visit,
+                              const std::function<void(std::size_t)>& progress = {},
+                              std::span<const float> values = {}) const;
+
+  // Every point's exact squared distance to its k-th nearest point, itself counted first (k = 9
+  // gives the 8th nearest other point): a local spacing, for k up to params.k. The block of one
+  // cell around a query's cell and a running list of the k smallest replace the sorted lists.
+  // Computed as (x_j - x_q)² + (y_j - y_q)² + (z_j - z_q)² in float without fused multiply-adds,
+  // as a visitor of for_each computes it from dx, dy, dz. Throws glint::Error when k is outside
+  // [1, kMaxSmallK] or the cloud has fewer than k points.
+  std::vector<float> kth_nearest_squared_distances(
+      int k, const std::function<void(std::size_t)>& progress = {}) const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+// NeighbourhoodSearch(cloud, params).for_each(visit, progress), for a single pass.
 NeighbourhoodStats for_each_neighbourhood(const PointCloud& cloud,
                                           const NeighbourhoodParams& params,
                                           const std::function<void(const Neighbourhood&)>& visit,

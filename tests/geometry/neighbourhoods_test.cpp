@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <mutex>
 #include <random>
@@ -125,6 +126,84 @@ TEST(Neighbourhoods, LatticesWithManyEqualDistancesComeOutSorted) {
     EXPECT_EQ(wrong_prefix, 0u);
     EXPECT_EQ(visited, cloud->size());
   }
+}
+
+TEST(Neighbourhoods, KthDistancesEqualTheSortedListsEntry) {
+  // The small-k pass must give exactly what a visitor computes from the k-th entry of a sorted
+  // list (area weights depend on it bit for bit), on an uneven cloud with outliers (retries and
+  // the k-d tree) and on a lattice full of equal distances.
+  PointCloud lattice;
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j) lattice.push_back(0.5f * float(i), 0.5f * float(j), 0.f);
+  for (const PointCloud& cloud : {uneven_cloud(), lattice}) {
+    NeighbourhoodParams params;
+    params.k = 64;
+    const NeighbourhoodSearch search(cloud, params);
+    for (const int k : {1, 9, kMaxSmallK}) {
+      std::vector<float> expected(cloud.size(), -1.f);
+      NeighbourhoodParams small;
+      small.k = k;
+      for_each_neighbourhood(cloud, small, [&](const Neighbourhood& nb) {
+        const int last = k - 1;
+        expected[nb.point] =
+            nb.dx[last] * nb.dx[last] + nb.dy[last] * nb.dy[last] + nb.dz[last] * nb.dz[last];
+      });
+      std::size_t done = 0;
+      const std::vector<float> kth =
+          search.kth_nearest_squared_distances(k, [&](std::size_t points) { done += points; });
+      ASSERT_EQ(kth.size(), cloud.size());
+      std::size_t different = 0;
+      for (std::size_t i = 0; i < cloud.size(); ++i) different += kth[i] != expected[i];
+      EXPECT_EQ(different, 0u) << "k = " << k;
+      EXPECT_EQ(done, cloud.size());
+    }
+  }
+  const PointCloud cloud = uneven_cloud();
+  const float outlier = KdTree(cloud).knn_all(9).squared_distances.back();
+  NeighbourhoodParams params;
+  params.k = 16;
+  EXPECT_EQ(NeighbourhoodSearch(cloud, params).kth_nearest_squared_distances(9).back(), outlier);
+}
+
+TEST(Neighbourhoods, KthDistancesRefuseBadK) {
+  PointCloud cloud;
+  for (int i = 0; i < 20; ++i) cloud.push_back(float(i), 0.f, 0.f);
+  NeighbourhoodParams params;
+  params.k = 8;
+  const NeighbourhoodSearch search(cloud, params);
+  EXPECT_THROW(search.kth_nearest_squared_distances(0), glint::Error);
+  EXPECT_THROW(search.kth_nearest_squared_distances(kMaxSmallK + 1), glint::Error);
+  PointCloud tiny;
+  for (int i = 0; i < 5; ++i) tiny.push_back(float(i), 1.f, 0.f);
+  params.k = 5;
+  EXPECT_THROW(NeighbourhoodSearch(tiny, params).kth_nearest_squared_distances(6), glint::Error);
+  EXPECT_EQ(NeighbourhoodSearch(tiny, params).kth_nearest_squared_distances(5)[0], 16.f);
+}
+
+TEST(Neighbourhoods, CarriedValuesFollowTheirNeighbours) {
+  // Every neighbour's value must be its own point's, also for the outliers' k-d tree answers.
+  const PointCloud cloud = uneven_cloud();
+  std::vector<float> values(cloud.size());
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = 0.5f * float(i);
+  NeighbourhoodParams params;
+  params.k = 32;
+  const NeighbourhoodSearch search(cloud, params);
+  std::atomic<std::size_t> wrong{0}, visited{0};
+  const NeighbourhoodStats stats = search.for_each(
+      [&](const Neighbourhood& nb) {
+        ASSERT_NE(nb.values, nullptr);
+        std::size_t local = 0;
+        for (int j = 0; j < nb.size; ++j) local += nb.values[j] != 0.5f * float(nb.indices[j]);
+        wrong += local;
+        ++visited;
+      },
+      {}, values);
+  EXPECT_EQ(wrong, 0u);
+  EXPECT_EQ(visited, cloud.size());
+  EXPECT_GT(stats.fallback_queries, 0u);
+  search.for_each([](const Neighbourhood& nb) { EXPECT_EQ(nb.values, nullptr); });
+  values.pop_back();
+  EXPECT_THROW(search.for_each([](const Neighbourhood&) {}, {}, values), glint::Error);
 }
 
 }  // namespace
