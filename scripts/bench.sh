@@ -8,6 +8,9 @@ OUT=build/bench
 mkdir -p "$OUT"
 "$BUILD/bench/edges/edges_throughput" --points 1000000 --repeat 3 --model models/bounded-3c.json \
   --data "$DATA" --json "$OUT/edges_throughput.json"
+# The 2-class model weighs neighbours by area: one more (small-k) pass before the features.
+"$BUILD/bench/edges/edges_throughput" --points 1000000 --repeat 3 --model models/bounded-2c.json \
+  --data "$DATA" --json "$OUT/edges_throughput_2c.json"
 # The PCL / Open3D boundary peers, where they were built (scripts/install-deps.sh --peers).
 if [[ -x "$BUILD/bench/edges/boundary_peers" ]]; then
   "$BUILD/bench/edges/boundary_peers" "$DATA/pointclouds/default-eval" "$DATA/pointclouds/shrec19" \

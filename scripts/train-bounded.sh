@@ -11,7 +11,8 @@
 #     teach "boundary = non-edge".
 # The 3-class model takes the angular gap as a thirteenth input per scale (--angular-gap,
 # docs/decisions.md "The angular gap as a thirteenth input of the 3-class model"); the 2-class
-# model keeps the thesis's twelve.
+# model keeps the thesis's twelve, with neighbours weighed by area (--area-weights,
+# docs/decisions.md "Area-weighted neighbourhoods").
 # The procedural shapes of `glint edges synth` are left out: with them the CAD validation score
 # below was lower (docs/decisions.md, "BoundED trains on CAD-kernel parts, not procedural shapes").
 # Each model is trained with seeds 1, 2 and 3 (two trainings at a time), and so is a low-noise
@@ -50,7 +51,7 @@ train() {  # name classes seed notes data-and-excludes...
     > "$WORK/models/train-$name.log" 2>&1
 }
 DATA_3C=("$WORK/cad" "$BAZAZIAN" "${TWINS[@]}" "${OPEN_SURFACES[@]}" --angular-gap)
-DATA_2C=("$WORK/cad" "$BAZAZIAN" "${TWINS[@]}")
+DATA_2C=("$WORK/cad" "$BAZAZIAN" "${TWINS[@]}" --area-weights)
 for seed in $SEEDS; do
   [[ -f "$WORK/models/bounded-3c-s$seed.json" ]] ||
     train "bounded-3c-s$seed" 3 "$seed" "$NOTES" "${DATA_3C[@]}" &
@@ -59,16 +60,13 @@ for seed in $SEEDS; do
   wait
 done
 
-# With AREA_WEIGHTS=1 also both models with area-weighted neighbourhoods (--area-weights,
-# docs/decisions.md "Area-weighted neighbourhoods: built, not shipped"), seeds 1, 2 and 3, for
-# scripts/eval-bounded-cad.sh; they are not candidates of the selection below.
+# With AREA_WEIGHTS=1 also the 3-class model with area-weighted neighbourhoods (docs/decisions.md
+# "Area-weighted neighbourhoods"), seeds 1, 2 and 3, for scripts/eval-bounded-cad.sh; they are
+# not candidates of the selection below.
 if [[ ${AREA_WEIGHTS:-0} == 1 ]]; then
   for seed in $SEEDS; do
     [[ -f "$WORK/models/bounded-3c-area-s$seed.json" ]] ||
-      train "bounded-3c-area-s$seed" 3 "$seed" "$NOTES" "${DATA_3C[@]}" --area-weights &
-    [[ -f "$WORK/models/bounded-2c-area-s$seed.json" ]] ||
-      train "bounded-2c-area-s$seed" 2 "$seed" "$NOTES" "${DATA_2C[@]}" --area-weights &
-    wait
+      train "bounded-3c-area-s$seed" 3 "$seed" "$NOTES" "${DATA_3C[@]}" --area-weights
   done
 fi
 
@@ -84,7 +82,7 @@ CLEAN_NOTES="Low-noise network: the clean clouds (noise 0) of glint edges synth 
 for seed in $SEEDS; do
   for classes in 3 2; do
     name="bounded-${classes}c-clean-s$seed"
-    inputs=()
+    inputs=(--area-weights)  # a gated pair's networks take the same features
     [[ $classes == 3 ]] && inputs=(--angular-gap)
     [[ -f "$WORK/models/$name.json" ]] ||
       train "$name" "$classes" "$seed" "$CLEAN_NOTES" "${CLEAN[@]}" "${inputs[@]}" &
