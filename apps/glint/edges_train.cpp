@@ -183,7 +183,7 @@ void register_edges_train(CLI::App& edges) {
                     "Weigh each neighbour by the surface it stands for (its squared distance to "
                     "its 8th nearest point, relative to the query's, clamped to [1/16, 16]): "
                     "features that follow the surface rather than the sampling density, e.g. "
-                    "the mesh vertices of CAD tessellations");
+                    "the mesh vertices of CAD tessellations (the shipped 2-class model has it)");
   command
       ->add_option("--exclude", options->exclude,
                    "Skip files whose name contains PATTERN; repeat the flag for more patterns "
