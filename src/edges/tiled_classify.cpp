@@ -19,6 +19,7 @@
 #include "core/progress.h"
 #include "core/timer.h"
 #include "edges/classifier.h"
+#include "edges/features.h"
 #include "io/las.h"
 
 namespace glint::edges {
@@ -166,6 +167,38 @@ std::vector<double> column_halos(const CountGrid& grid, const std::vector<std::u
     }
   });
   return halos;
+}
+
+// An area-weighted model also needs the spacings of a core point's neighbours, so the tile must
+// hold their spacing neighbours too. A neighbour j lies within the column's halo h of the core
+// point and j's spacing neighbour within the spacing bound of j's own column: h + the largest
+// spacing bound of the columns within h. At most 3h, a bound that needs no window (j's spacing
+// neighbour lies within 2h of j, since the core point's k nearest do), taken where the window
+// of columns would be wide.
+std::vector<double> area_weighted_halos(const CountGrid& grid, const std::vector<double>& halos,
+                                        const std::vector<double>& spacing_halos) {
+  constexpr std::int64_t kMaxWindow = 16;  // columns either side
+  std::vector<double> reach(halos.size(), 0.0);
+  parallel_for(std::size_t(grid.dims[0]), [&](std::size_t column_x) {
+    const auto ix = std::int64_t(column_x);
+    for (std::int64_t iy = 0; iy < grid.dims[1]; ++iy) {
+      const std::size_t column = std::size_t(ix * grid.dims[1] + iy);
+      const double h = halos[column];
+      reach[column] = 3.0 * h;
+      // A point within h of the column lies at most ceil(h / cell) columns away per axis.
+      const auto wx = std::int64_t(std::ceil(h / grid.cell_m[0]));
+      const auto wy = std::int64_t(std::ceil(h / grid.cell_m[1]));
+      if (h == 0 || wx > kMaxWindow || wy > kMaxWindow) continue;
+      double spacing = 0;
+      for (std::int64_t x = std::max<std::int64_t>(0, ix - wx);
+           x <= std::min(grid.dims[0] - 1, ix + wx); ++x)
+        for (std::int64_t y = std::max<std::int64_t>(0, iy - wy);
+             y <= std::min(grid.dims[1] - 1, iy + wy); ++y)
+          spacing = std::max(spacing, spacing_halos[std::size_t(x * grid.dims[1] + y)]);
+      reach[column] = std::min(reach[column], h + spacing);
+    }
+  });
+  return reach;
 }
 
 // Square tiles of `side` count-grid columns, each with its own halo.
@@ -437,13 +470,8 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
       });
   world.sum(counts);
   std::vector<double> halos = column_halos(grid, counts, k);
-  if (model.config.area_weights) {
-    // A core point's neighbour j lies within the halo h of it, and j's own spacing neighbour
-    // within j's k-th neighbour distance, at most 2h (the core point's k nearest are all within
-    // h of it, so within 2h of j): the tile must reach 3h for the weights to be the whole
-    // cloud's.
-    for (double& halo : halos) halo *= 3.0;
-  }
+  if (model.config.area_weights)
+    halos = area_weighted_halos(grid, halos, column_halos(grid, counts, kAreaSpacingNeighbour + 1));
 
   // The largest tiles whose points, halo included, fit the limit.
   ColumnSums sums(grid, counts);
