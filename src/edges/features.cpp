@@ -237,14 +237,13 @@ void scale_features(const ScaleState& state, const ScaleState& largest, const Ve
   }
 }
 
-// The area weights of neighbourhood nb (features.h), from every point's squared spacing.
-const float* area_weights(const geometry::Neighbourhood& nb, const float* squared_spacings,
-                          Scratch& scratch) {
+// The area weights of neighbourhood nb (features.h) from its neighbours' squared spacings,
+// nb.values. The nearest neighbour is the query point or a duplicate of it: the same spacing.
+const float* area_weights(const geometry::Neighbourhood& nb, Scratch& scratch) {
   scratch.weights.resize(std::size_t(nb.size));
   float* weights = scratch.weights.data();
   // A query with duplicates closer than its spacing neighbour has spacing 0: the clamp decides.
-  const float query = std::max(squared_spacings[nb.point], std::numeric_limits<float>::min());
-  // The neighbours' spacings come with the neighbourhood (nb.values).
+  const float query = std::max(nb.values[0], std::numeric_limits<float>::min());
   for (int j = 0; j < nb.size; ++j)
     weights[j] = std::clamp(nb.values[j] / query, 1.0f / kMaxAreaWeight, kMaxAreaWeight);
   return weights;
@@ -252,13 +251,13 @@ const float* area_weights(const geometry::Neighbourhood& nb, const float* square
 
 // All scales of one point. The neighbour list is ordered nearest first, so the moments of
 // every scale come from one pass with prefix sums; the eigen solves of all scales run as two
-// batches (vectorised across matrices). Neighbours weigh 1, or their area weight when
-// squared_spacings is given (kAreaWeights).
+// batches (vectorised across matrices). Neighbours weigh 1, or their area weight when the
+// neighbourhood carries squared spacings (kAreaWeights).
 template <bool kAreaWeights>
 void point_features(const geometry::Neighbourhood& nb, const FeatureParams& params,
-                    const float* squared_spacings, Scratch& scratch, float* row) {
+                    Scratch& scratch, float* row) {
   const float* weights = nullptr;
-  if constexpr (kAreaWeights) weights = area_weights(nb, squared_spacings, scratch);
+  if constexpr (kAreaWeights) weights = area_weights(nb, scratch);
   const auto weight = [weights](int j) {
     if constexpr (kAreaWeights) return weights[j];
     return 1.f;
@@ -324,30 +323,28 @@ void point_features(const geometry::Neighbourhood& nb, const FeatureParams& para
   }
 }
 
-using PointKernel = void (*)(const geometry::Neighbourhood&, const FeatureParams&, const float*,
-                             Scratch&, float*);
+using PointKernel = void (*)(const geometry::Neighbourhood&, const FeatureParams&, Scratch&,
+                             float*);
 
 void point_features_either(const geometry::Neighbourhood& nb, const FeatureParams& params,
-                           const float* squared_spacings, Scratch& scratch, float* row) {
-  if (squared_spacings)
-    point_features<true>(nb, params, squared_spacings, scratch, row);
+                           Scratch& scratch, float* row) {
+  if (nb.values)
+    point_features<true>(nb, params, scratch, row);
   else
-    point_features<false>(nb, params, nullptr, scratch, row);
+    point_features<false>(nb, params, scratch, row);
 }
 
 [[gnu::flatten]] void point_features_baseline(const geometry::Neighbourhood& nb,
-                                              const FeatureParams& params,
-                                              const float* squared_spacings, Scratch& scratch,
+                                              const FeatureParams& params, Scratch& scratch,
                                               float* row) {
-  point_features_either(nb, params, squared_spacings, scratch, row);
+  point_features_either(nb, params, scratch, row);
 }
 #if defined(__x86_64__)
 // The same code in eight-lane vectors with fused multiply-adds: the moment sums round in
 // another order, so features differ from the baseline's by float rounding.
 [[gnu::target("arch=x86-64-v3"), gnu::flatten]] void point_features_x86_64_v3(
-    const geometry::Neighbourhood& nb, const FeatureParams& params, const float* squared_spacings,
-    Scratch& scratch, float* row) {
-  point_features_either(nb, params, squared_spacings, scratch, row);
+    const geometry::Neighbourhood& nb, const FeatureParams& params, Scratch& scratch, float* row) {
+  point_features_either(nb, params, scratch, row);
 }
 #endif
 
@@ -426,14 +423,14 @@ void compute_rows(const PointCloud& cloud, const FeatureParams& params,
   geometry::NeighbourhoodParams search_params;
   search_params.k = params.scales[0];
   const geometry::NeighbourhoodSearch search(cloud, search_params);
+  // Handed out per neighbour with the positions, where the kernel weighs by them.
   const std::vector<float> spacings =
       params.area_weights ? squared_spacings(cloud, search) : std::vector<float>();
-  const float* spacing_of = spacings.empty() ? nullptr : spacings.data();
   ProgressBar progress("features", cloud.size());
   const geometry::NeighbourhoodStats stats = search.for_each(
       [&](const geometry::Neighbourhood& nb) {
         Scratch& scratch = scratches.local();
-        kernel(nb, params, spacing_of, scratch, row_for(nb.point, scratch));
+        kernel(nb, params, scratch, row_for(nb.point, scratch));
         row_written(scratch);
       },
       [&](std::size_t done) { progress.advance(done); }, spacings);
