@@ -4,7 +4,8 @@
 #   scripts/eval-bounded-cad.sh [GLINT] [DATA] [TRAIN] [WORK]
 # TRAIN is scripts/train-bounded.sh's folder: its models/bounded-<c>c-s{1,2,3}.json (the three
 # training seeds), bounded-<c>c-gated-s{1,2,3}.json (the noise-gated pairs of the three clean
-# seeds), bounded-3c-area-s{1,2,3}.json (area-weighted neighbourhoods, AREA_WEIGHTS=1) and
+# seeds), bounded-3c-area-s{1,2,3}.json (area-weighted neighbourhoods, AREA_WEIGHTS=1),
+# bounded-<c>c-vertices-s{1,2,3}.json (more mesh-vertex clouds, MESH_VERTICES=1) and
 # bounded-<c>c-old.json (the models shipped before them) are scored beside
 # the baselines `glint edges eval` prints (CA, and the angle-gap boundary criterion where the
 # build has it).
@@ -29,7 +30,8 @@ done
 models() {  # classes
   for m in "$TRAIN/models/bounded-$1c-old.json" "$TRAIN"/models/bounded-"$1"c-s[0-9].json \
     "$TRAIN"/models/bounded-"$1"c-gated-s[0-9].json \
-    "$TRAIN"/models/bounded-"$1"c-area-s[0-9].json; do
+    "$TRAIN"/models/bounded-"$1"c-area-s[0-9].json \
+    "$TRAIN"/models/bounded-"$1"c-vertices-s[0-9].json; do
     printf -- '--model %s ' "$m"
   done
 }

@@ -70,6 +70,26 @@ if [[ ${AREA_WEIGHTS:-0} == 1 ]]; then
   done
 fi
 
+# With MESH_VERTICES=1 also both models trained on 300 more parts (seed 102) sampled only at
+# mesh vertices beside their own data (docs/decisions.md "More mesh-vertex clouds in training"),
+# seeds 1, 2 and 3, for scripts/eval-bounded-cad.sh; they are not candidates of the selection.
+if [[ ${MESH_VERTICES:-0} == 1 ]]; then
+  [[ -f "$WORK/cad-vertices/manifest.json" ]] ||
+    "${NICE[@]}" "$GLINT" edges synth --kind cad -o "$WORK/cad-vertices" --count 300 --seed 102 \
+      --recipes block,plate,extrusion,turned --plane-cut 0.2 --faces-removed 0.15 \
+      --noise 0,0,0.25,0.5,1 --min-points 3000 --max-points 30000 --sampling vertices
+  VERTEX_NOTES="$NOTES; plus 300 clouds of seed 102 sampled at mesh vertices"
+  for seed in $SEEDS; do
+    [[ -f "$WORK/models/bounded-3c-vertices-s$seed.json" ]] ||
+      train "bounded-3c-vertices-s$seed" 3 "$seed" "$VERTEX_NOTES" "$WORK/cad" \
+        "$WORK/cad-vertices" "${DATA_3C[@]:1}" &
+    [[ -f "$WORK/models/bounded-2c-vertices-s$seed.json" ]] ||
+      train "bounded-2c-vertices-s$seed" 2 "$seed" "$VERTEX_NOTES" "$WORK/cad" \
+        "$WORK/cad-vertices" "${DATA_2C[@]:1}" &
+    wait
+  done
+fi
+
 # The low-noise networks of the noise gate: the clean CAD parts alone (noise 0; the bazazian
 # clouds are left out, docs/decisions.md "The noise gate: built, not shipped").
 mapfile -t CLEAN < <(/usr/bin/python3 -c '
