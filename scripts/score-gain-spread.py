@@ -18,17 +18,13 @@ import json
 import numpy as np
 
 
-def mcc_per_part(report, method):
+def mcc_per_part(report, methods):
+    """Per method, its MCC on every part of the report, in the report's order."""
     files = json.load(open(report))["files"]
     try:
-        return np.array([f["scores"][method]["mcc"] for f in files])
-    except KeyError:
-        raise SystemExit(f"{report}: no method '{method}' in its files' scores")
-
-
-def median_gain(report, shipped, candidate, parts):
-    return (np.median(mcc_per_part(report, candidate)[parts])
-            - np.median(mcc_per_part(report, shipped)[parts]))
+        return [np.array([f["scores"][m]["mcc"] for f in files]) for m in methods]
+    except KeyError as missing:
+        raise SystemExit(f"{report}: no method {missing} in its files' scores")
 
 
 def main():
@@ -39,19 +35,19 @@ def main():
     parser.add_argument("--draws", type=int, default=2000)
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
-    reports = [s.split(":") for s in args.sets]
-    sizes = [[len(json.load(open(r))["files"]) for r in pair] for pair in reports]
+    # Per set, per report: (shipped, candidate) MCC per part.
+    sets = [[mcc_per_part(r, (args.shipped, args.candidate)) for r in s.split(":")]
+            for s in args.sets]
 
-    def gain(draw):  # draw: one index array per report, or None for the observed parts
-        per_set = []
-        for pair, parts in zip(reports, draw):
-            gains = [median_gain(r, args.shipped, args.candidate, p) for r, p in zip(pair, parts)]
-            per_set.append(np.mean(gains))
-        return float(np.mean(per_set))
+    def gain(draw):  # draw: one index array (or slice) per report of every set
+        return float(np.mean([np.mean([np.median(candidate[parts]) - np.median(shipped[parts])
+                                       for (shipped, candidate), parts in zip(reports, chosen)])
+                              for reports, chosen in zip(sets, draw)]))
 
-    observed = gain([[slice(None)] * len(pair) for pair in reports])
+    observed = gain([[slice(None)] * len(reports) for reports in sets])
     rng = np.random.default_rng(args.seed)
-    draws = np.array([gain([[rng.integers(0, n, n) for n in set_sizes] for set_sizes in sizes])
+    draws = np.array([gain([[rng.integers(0, len(shipped), len(shipped)) for shipped, _ in reports]
+                            for reports in sets])
                       for _ in range(args.draws)])
     low, high = np.percentile(draws, [5, 95])
     print(f"{args.candidate} - {args.shipped}: observed gain {observed:+.4f}; {args.draws} "
