@@ -109,11 +109,13 @@ CountGrid make_count_grid(const std::int64_t low[3], const std::int64_t high[3],
   return grid;
 }
 
-// Per xy column of the count grid: the largest proven k-th neighbour distance bound (metres) of
-// the cells in it, 0 for empty columns.
-std::vector<double> column_halos(const CountGrid& grid, const std::vector<std::uint64_t>& counts,
-                                 int k) {
-  // Pyramid: level l has cells 2^l times larger per axis.
+// The grid's counts summed over cells 2^l times larger per axis at level l (level 0: the grid).
+struct CountPyramid {
+  std::vector<std::vector<std::uint64_t>> levels;
+  std::vector<std::array<std::int64_t, 3>> level_dims;
+};
+
+CountPyramid count_pyramid(const CountGrid& grid, const std::vector<std::uint64_t>& counts) {
   std::vector<std::vector<std::uint64_t>> levels{counts};
   std::vector<std::array<std::int64_t, 3>> level_dims{{grid.dims[0], grid.dims[1], grid.dims[2]}};
   while (level_dims.back()[0] > 1 || level_dims.back()[1] > 1 || level_dims.back()[2] > 1) {
@@ -133,6 +135,14 @@ std::vector<double> column_halos(const CountGrid& grid, const std::vector<std::u
     levels.push_back(std::move(up));
     level_dims.push_back(dims);
   }
+  return {std::move(levels), std::move(level_dims)};
+}
+
+// Per xy column of the count grid: the largest proven k-th neighbour distance bound (metres) of
+// the cells in it, 0 for empty columns.
+std::vector<double> column_halos(const CountGrid& grid, const CountPyramid& pyramid, int k) {
+  const auto& levels = pyramid.levels;
+  const auto& level_dims = pyramid.level_dims;
   const double diagonal =
       std::sqrt(grid.cell_m[0] * grid.cell_m[0] + grid.cell_m[1] * grid.cell_m[1] +
                 grid.cell_m[2] * grid.cell_m[2]);
@@ -141,7 +151,7 @@ std::vector<double> column_halos(const CountGrid& grid, const std::vector<std::u
     for (std::int64_t iy = 0; iy < grid.dims[1]; ++iy) {
       double& halo = halos[std::size_t(std::int64_t(ix) * grid.dims[1] + iy)];
       for (std::int64_t iz = 0; iz < grid.dims[2]; ++iz) {
-        if (counts[grid.cell(std::int64_t(ix), iy, iz)] == 0) continue;
+        if (levels[0][grid.cell(std::int64_t(ix), iy, iz)] == 0) continue;
         for (std::size_t level = 0; level < levels.size(); ++level) {
           const auto& dims = level_dims[level];
           const std::int64_t c[3] = {std::int64_t(ix) >> level, iy >> level, iz >> level};
@@ -469,9 +479,14 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
         }
       });
   world.sum(counts);
-  std::vector<double> halos = column_halos(grid, counts, k);
-  if (model.config.area_weights)
-    halos = area_weighted_halos(grid, halos, column_halos(grid, counts, kAreaSpacingNeighbour + 1));
+  // The pyramid (up to 8/7 of the counts) is freed before the tiles are read.
+  const std::vector<double> halos = [&] {
+    const CountPyramid pyramid = count_pyramid(grid, counts);
+    std::vector<double> counting = column_halos(grid, pyramid, k);
+    if (!model.config.area_weights) return counting;
+    return area_weighted_halos(grid, counting,
+                               column_halos(grid, pyramid, kAreaSpacingNeighbour + 1));
+  }();
 
   // The largest tiles whose points, halo included, fit the limit.
   ColumnSums sums(grid, counts);
