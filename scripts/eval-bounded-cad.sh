@@ -5,12 +5,14 @@
 # TRAIN is scripts/train-bounded.sh's folder: its models/bounded-<c>c-s{1,2,3}.json (the three
 # training seeds), bounded-<c>c-gated-s{1,2,3}.json (the noise-gated pairs of the three clean
 # seeds), bounded-3c-area-s{1,2,3}.json (area-weighted neighbourhoods, AREA_WEIGHTS=1),
-# bounded-<c>c-vertices-s{1,2,3}.json (more mesh-vertex clouds, MESH_VERTICES=1) and
+# bounded-<c>c-vertices-s{1,2,3}.json (more mesh-vertex clouds, MESH_VERTICES=1),
+# bounded-<c>c-sampling-s{1,2,3}.json (the sampling-gated pairs of the mesh-vertex seeds) and
 # bounded-<c>c-old.json (the models shipped before them) are scored beside
 # the baselines `glint edges eval` prints (CA, and the angle-gap boundary criterion where the
 # build has it).
-# Held-out set: 20 parts of seed 9001 (training used seed 101, model selection seed 5001; the
-# recipe `cylinder` was never trained on), each sampled at its mesh vertices and uniformly,
+# Held-out set: 20 parts of seed 9001, or of $SEED in another WORK (training used seeds 101 and
+# 102, model selection seeds 5001, 5002 and 5301; the recipe `cylinder` was never trained on),
+# each sampled at its mesh vertices and uniformly,
 # clean and with noise 0.25, 0.5 and 1 median spacing along the normal: sharp edges scored on
 # the closed parts, boundaries on the same parts cut open by a random plane. The angle-gap
 # criterion runs at its default (1.5 local spacings, k 16) and at 4 spacings, k 64.
@@ -20,6 +22,7 @@ GLINT=${1:-build/release/apps/glint/glint}
 DATA=${2:-${GLINT_DATA:-../shared/data}}
 TRAIN=${3:-build/train}
 WORK=${4:-build/eval-cad}
+SEED=${SEED:-9001}
 NICE=(nice -n 10)
 mkdir -p "$WORK" "$TRAIN/models"
 for classes in 3 2; do  # the models shipped before the CAD-kernel training, if not kept yet
@@ -31,7 +34,8 @@ models() {  # classes
   for m in "$TRAIN/models/bounded-$1c-old.json" "$TRAIN"/models/bounded-"$1"c-s[0-9].json \
     "$TRAIN"/models/bounded-"$1"c-gated-s[0-9].json \
     "$TRAIN"/models/bounded-"$1"c-area-s[0-9].json \
-    "$TRAIN"/models/bounded-"$1"c-vertices-s[0-9].json; do
+    "$TRAIN"/models/bounded-"$1"c-vertices-s[0-9].json \
+    "$TRAIN"/models/bounded-"$1"c-sampling-s[0-9].json; do
     printf -- '--model %s ' "$m"
   done
 }
@@ -48,8 +52,8 @@ for sampling in vertices uniform; do
       cut=0
       [[ $opening == cut ]] && cut=1
       [[ -f "$set_dir/manifest.json" ]] ||
-        "${NICE[@]}" "$GLINT" --quiet edges synth --kind cad -o "$set_dir" --count 20 --seed 9001 \
-          --sampling "$sampling" --noise "$noise" --outliers 0 --plane-cut "$cut" \
+        "${NICE[@]}" "$GLINT" --quiet edges synth --kind cad -o "$set_dir" --count 20 \
+          --seed "$SEED" --sampling "$sampling" --noise "$noise" --outliers 0 --plane-cut "$cut" \
           --min-points 4000 --max-points 40000
     done
     evaluate "$WORK/sets/$sampling-noise$noise-closed" sharp \

@@ -14,11 +14,9 @@ as WORK/models/bounded-<c>c-gated-s<seed>.json.
 import json
 import pathlib
 import shutil
-import statistics
-import subprocess
 import sys
 
-from bounded_eval import run_eval
+from bounded_eval import evaluate_groups, gate
 
 THRESHOLDS = [0.01, 0.02, 0.03, 0.05, 0.07, 0.1, 0.15, 0.2, 0.3, 0.5]
 MARGIN = 0.02      # the pair must beat the shipped model's validation score by this much
@@ -26,34 +24,10 @@ MAX_LOSS = 0.03    # and lose no more than this median MCC on any noisy validati
 NOISY = (0.5, 1.0)  # the noise levels (spacings) of those groups
 
 
-def evaluate(glint, folder, task, models, report):
-    """Per model: median MCC over the folder, and per (sampling, noise) group."""
-    files = run_eval(glint, folder, task, models, report)["files"]
-    manifest = json.loads((folder / "manifest.json").read_text())
-    group_of = {c["file"]: (c["sampling"], float(c["noise_spacings"])) for c in manifest["clouds"]}
-    result = {}
-    for model in models:
-        method = "glint:" + model.stem
-        mcc = [(group_of[pathlib.Path(f["file"]).name], f["scores"][method]["mcc"]) for f in files]
-        groups = {}
-        for group, value in mcc:
-            groups.setdefault(group, []).append(value)
-        result[model.stem] = {"median": statistics.median(v for _, v in mcc),
-                              "groups": {g: statistics.median(v) for g, v in groups.items()}}
-    return result
-
-
 def noisy_losses(candidate, shipped):
     """Median MCC lost against the shipped model on each noisy validation group."""
     return [shipped["groups"][g] - candidate["groups"][g]
             for g in shipped["groups"] if g[1] in NOISY]
-
-
-def gate(glint, noisy, clean, threshold, output):
-    if not output.exists():
-        subprocess.run([glint, "--quiet", "edges", "gate", str(noisy), str(clean), "--threshold",
-                        str(threshold), "-o", str(output)], check=True, stdout=subprocess.DEVNULL)
-    return output
 
 
 def main():
@@ -68,6 +42,7 @@ def main():
             shutil.copyfile(models_dir / f"bounded-{classes}c.json", shipped)
         single = json.loads(shipped.read_text())
         single.pop("noise_gate", None)
+        single.pop("sampling_gate", None)
         noisy = trained / f"bounded-{classes}c-noisy.json"
         noisy.write_text(json.dumps(single))
         clean = sorted(trained.glob(f"bounded-{classes}c-clean-s*.json"))
@@ -80,9 +55,9 @@ def main():
                 candidates[(seed, t)] = gate(glint, noisy, network, t,
                                              pairs / f"gated-{classes}c-s{seed}-t{t}.json")
         models = [shipped] + list(candidates.values())
-        sharp = evaluate(glint, work / "cad-val", "sharp", models,
+        sharp = evaluate_groups(glint, work / "cad-val", "sharp", models,
                          pairs / f"val-sharp-{classes}c.json")
-        boundary = (evaluate(glint, work / "cad-val-cut", "boundary", models,
+        boundary = (evaluate_groups(glint, work / "cad-val-cut", "boundary", models,
                              pairs / f"val-boundary-{classes}c.json") if classes == 3 else {})
 
         def score(stem):

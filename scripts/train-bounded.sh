@@ -23,7 +23,10 @@
 # disjoint from the training seed 101 and the evaluation seed 9001), by the rule written in
 # models/README.md before the first training; never on default-eval or shrec19.
 # scripts/select-noise-gate.py then pairs the chosen network with a low-noise one
-# (`glint edges gate`) by the rule of models/README.md, "The noise gate".
+# (`glint edges gate`) by the rule of models/README.md, "The noise gate", and
+# scripts/select-sampling-gate.py with a network trained on mesh-vertex clouds alone (300 more
+# parts, seed 102), behind the sampling gate, by the rule of models/README.md, "The sampling
+# gate", on decision sets of seed 5301: the shipped 3-class model is such a pair.
 set -euo pipefail
 GLINT=${1:-build/release/apps/glint/glint}
 DATA=${2:-${GLINT_DATA:-../shared/data}}
@@ -70,14 +73,17 @@ if [[ ${AREA_WEIGHTS:-0} == 1 ]]; then
   done
 fi
 
-# With MESH_VERTICES=1 also both models trained on 300 more parts (seed 102) sampled only at
-# mesh vertices beside their own data (docs/decisions.md "More mesh-vertex clouds in training"),
-# seeds 1, 2 and 3, for scripts/eval-bounded-cad.sh; they are not candidates of the selection.
+# 300 more parts (seed 102) sampled only at mesh vertices: with the mesh-vertex clouds of the
+# first set, the training data of the sampling gate's networks (below).
+[[ -f "$WORK/cad-vertices/manifest.json" ]] ||
+  "${NICE[@]}" "$GLINT" edges synth --kind cad -o "$WORK/cad-vertices" --count 300 --seed 102 \
+    --recipes block,plate,extrusion,turned --plane-cut 0.2 --faces-removed 0.15 \
+    --noise 0,0,0.25,0.5,1 --min-points 3000 --max-points 30000 --sampling vertices
+
+# With MESH_VERTICES=1 also both models trained on those parts beside their own data
+# (docs/decisions.md "More mesh-vertex clouds in training"), seeds 1, 2 and 3, for
+# scripts/eval-bounded-cad.sh; they are not candidates of the selection.
 if [[ ${MESH_VERTICES:-0} == 1 ]]; then
-  [[ -f "$WORK/cad-vertices/manifest.json" ]] ||
-    "${NICE[@]}" "$GLINT" edges synth --kind cad -o "$WORK/cad-vertices" --count 300 --seed 102 \
-      --recipes block,plate,extrusion,turned --plane-cut 0.2 --faces-removed 0.15 \
-      --noise 0,0,0.25,0.5,1 --min-points 3000 --max-points 30000 --sampling vertices
   VERTEX_NOTES="$NOTES; plus 300 clouds of seed 102 sampled at mesh vertices"
   for seed in $SEEDS; do
     [[ -f "$WORK/models/bounded-3c-vertices-s$seed.json" ]] ||
@@ -110,6 +116,27 @@ for seed in $SEEDS; do
   wait
 done
 
+# The mesh-vertex networks of the sampling gate: mesh-vertex clouds alone, every noise level (the
+# bazazian clouds are left out; docs/decisions.md "The sampling gate").
+mapfile -t VERTEX_CLOUDS < <(/usr/bin/python3 -c '
+import json, sys
+folder = sys.argv[1]
+for cloud in json.load(open(folder + "/manifest.json"))["clouds"]:
+    if cloud["sampling"] == "vertices": print(folder + "/" + cloud["file"])' "$WORK/cad")
+MESH_VERTEX_NOTES="Mesh-vertex network: the mesh-vertex clouds of glint edges synth --kind cad \
+(seed 101) and 300 clouds of seed 102 sampled at mesh vertices"
+for seed in $SEEDS; do
+  for classes in 3 2; do
+    name="bounded-${classes}c-mesh-vertex-s$seed"
+    inputs=(--area-weights)
+    [[ $classes == 3 ]] && inputs=(--angular-gap)
+    [[ -f "$WORK/models/$name.json" ]] ||
+      train "$name" "$classes" "$seed" "$MESH_VERTEX_NOTES" "${VERTEX_CLOUDS[@]}" \
+        "$WORK/cad-vertices" "${inputs[@]}" &
+  done
+  wait
+done
+
 # The CAD validation set of the selection rule (seed 5001: neither trained on nor evaluated).
 [[ -f "$WORK/cad-val/manifest.json" ]] ||
   "${NICE[@]}" "$GLINT" edges synth --kind cad -o "$WORK/cad-val" --count 40 --seed 5001 \
@@ -119,3 +146,14 @@ done
     --sampling vertices,uniform --noise 0,0.5,1 --plane-cut 1 --min-points 4000 --max-points 40000
 /usr/bin/python3 "$(dirname "$0")/select-bounded.py" "$GLINT" "$WORK" models
 /usr/bin/python3 "$(dirname "$0")/select-noise-gate.py" "$GLINT" "$WORK" models
+# The decision sets of the sampling gate (seed 5301: 180 parts, scans included).
+for opening in closed cut; do
+  set_dir="$WORK/cad-dec"
+  cut=0
+  [[ $opening == cut ]] && set_dir="$WORK/cad-dec-cut" && cut=1
+  [[ -f "$set_dir/manifest.json" ]] ||
+    "${NICE[@]}" "$GLINT" edges synth --kind cad -o "$set_dir" --count 180 --seed 5301 \
+      --sampling vertices,uniform,scan --noise 0,0.5,1 --plane-cut "$cut" --min-points 4000 \
+      --max-points 40000
+done
+/usr/bin/python3 "$(dirname "$0")/select-sampling-gate.py" "$GLINT" "$WORK" models "$DATA"

@@ -51,16 +51,23 @@ bool is_las(const std::string& path) {
   return extension == ".las" || extension == ".laz";
 }
 
-// What the noise gate of a gated model chose, for the log and the report (null otherwise).
-nlohmann::json gate_entry(const edges::Model& model, std::uint64_t quiet, std::uint64_t points,
-                          bool low_noise) {
+// What the gate of a gated model chose, for the log and the report (null otherwise).
+nlohmann::json gate_entry(const edges::Model& model, double statistic, bool gate_network_answered) {
   if (!model.gated()) return nullptr;
-  log().info("noise gate: {:.1f} % of the points below {} -> the {} network answers",
-             100.0 * double(quiet) / double(std::max<std::uint64_t>(points, 1)),
-             model.noise_threshold, low_noise ? "low-noise" : "noisy");
-  return {{"threshold", model.noise_threshold},
-          {"quiet_points", quiet},
-          {"network", low_noise ? "low-noise" : "noisy"}};
+  const char* network = model.network_name(gate_network_answered);
+  if (model.gate_kind == edges::GateKind::noise) {
+    log().info("noise gate: {:.1f} % of the points below {} -> the {} network answers",
+               100.0 * statistic, model.gate_threshold, network);
+  } else {
+    log().info(
+        "sampling gate: spacing spread ln(P90/P10) {:.3f} against {} -> the {} network "
+        "answers",
+        statistic, model.gate_threshold, network);
+  }
+  return {{"kind", model.gate_kind == edges::GateKind::noise ? "noise" : "sampling"},
+          {"threshold", model.gate_threshold},
+          {"statistic", statistic},
+          {"network", network}};
 }
 
 // LAS in, LAS out: streamed, tiled when the cloud exceeds the memory limit, spread over the
@@ -100,8 +107,7 @@ void run_classify_las(const ClassifyOptions& options) {
                  e.what());
     world.abort(1);
   }
-  const nlohmann::json gate =
-      gate_entry(model, stats.quiet_points, stats.points, stats.low_noise_network);
+  const nlohmann::json gate = gate_entry(model, stats.gate_statistic, stats.gate_network_answered);
   if (world.size() > 1) {
     fmt::print(
         "rank {}/{}: {} tiles, {} points classified in {:.2f} s (read {:.2f} s, write "
@@ -141,7 +147,7 @@ void run_classify_las(const ClassifyOptions& options) {
                     {"tile_side_m", stats.tile_side_m},
                     {"halo_m_max", stats.halo_m_max},
                     {"halo_points", stats.halo_points},
-                    {"noise_gate", gate},
+                    {"gate", gate},
                     {"timings_s",
                      {{"read", stats.read_s},
                       {"classify", stats.classify_s},
@@ -172,7 +178,7 @@ void run_classify(const ClassifyOptions& options) {
   const nlohmann::json gate =
       options.method == "angle-gap"
           ? nlohmann::json(nullptr)
-          : gate_entry(model, result.quiet_points, cloud.size(), result.low_noise_network);
+          : gate_entry(model, result.gate_statistic, result.gate_network_answered);
   edges::attach_classification(cloud, result);
   // The picture is made before any file is written, and a failure writing it takes the PLY
   // back: the command leaves both outputs or neither.
@@ -210,7 +216,7 @@ void run_classify(const ClassifyOptions& options) {
          {"scales", options.scales.empty() ? model.config.scales : options.scales},
          {"points", cloud.size()},
          {"labels", {{"non_edge", counts[0]}, {"sharp", counts[1]}, {"boundary", counts[2]}}},
-         {"noise_gate", gate},
+         {"gate", gate},
          {"timings_s",
           {{"features", result.features_s}, {"network", result.inference_s}, {"total", total_s}}},
          {"points_per_s", double(cloud.size()) / total_s}});

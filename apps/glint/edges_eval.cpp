@@ -126,7 +126,7 @@ void run_eval(EvalOptions options) {
         const edges::Classification result = edges::classify_features(features, model);
         record(method, result.labels, features_s + result.inference_s);
         if (model.gated())
-          file_json["scores"][method]["network"] = result.low_noise_network ? "low-noise" : "noisy";
+          file_json["scores"][method]["network"] = model.network_name(result.gate_network_answered);
       }
       if (!options.predictions.empty()) {
         const std::string prediction_path = prediction_for(options.predictions, f, path);

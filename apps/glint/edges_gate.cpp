@@ -1,4 +1,4 @@
-// glint edges gate: joins two BoundED networks into one noise-gated model file.
+// glint edges gate: joins two BoundED networks into one gated model file.
 #include <fmt/format.h>
 
 #include <memory>
@@ -12,8 +12,9 @@ namespace glint::app {
 namespace {
 
 struct GateOptions {
-  std::string noisy;
-  std::string low_noise;
+  std::string model;
+  std::string gate_model;
+  std::string statistic = "noise";
   float threshold = 0;
   std::string output;
 };
@@ -22,20 +23,26 @@ void run_gate(const GateOptions& options) {
   if (!(options.threshold > 0.0f)) {
     throw Error("--threshold", fmt::format("{}", options.threshold), "must be > 0");
   }
-  const edges::Model noisy = edges::Model::load(options.noisy);
-  if (noisy.gated()) throw Error(options.noisy, "noise_gate", "already has a noise gate");
-  const edges::Model low_noise = edges::Model::load(options.low_noise);
+  if (options.statistic != "noise" && options.statistic != "sampling") {
+    throw Error("--statistic", options.statistic, "expected noise or sampling");
+  }
+  const edges::GateKind kind =
+      options.statistic == "noise" ? edges::GateKind::noise : edges::GateKind::sampling;
+  const edges::Model model = edges::Model::load(options.model);
+  if (model.gated()) throw Error(options.model, "", "already has a gate");
+  const edges::Model gate_model = edges::Model::load(options.gate_model);
   edges::Model gated;
   try {
-    gated = noisy.with_noise_gate(low_noise, options.threshold);
+    gated = model.with_gate(kind, gate_model, options.threshold);
   } catch (const Error& e) {  // the second network does not fit the first
-    throw Error(options.low_noise, e.element(),
+    throw Error(options.gate_model, e.element(),
                 fmt::format("{} (it must have the classes, scales and layers of {})", e.reason(),
-                            options.noisy));
+                            options.model));
   }
   gated.save(options.output);
-  fmt::print("{} (noisy clouds) + {} (low-noise clouds), threshold {} -> {}\n", options.noisy,
-             options.low_noise, options.threshold, options.output);
+  fmt::print("{} ({} clouds) + {} ({} clouds), threshold {} -> {}\n", options.model,
+             gated.network_name(false), options.gate_model, gated.network_name(true),
+             options.threshold, options.output);
 }
 
 }  // namespace
@@ -44,18 +51,30 @@ void register_edges_gate(CLI::App& edges) {
   auto options = std::make_shared<GateOptions>();
   CLI::App* command = edges.add_subcommand(
       "gate",
-      "Join two BoundED networks into one noise-gated model: the low-noise network answers a\n"
-      "cloud when more than half of its points have a noise statistic below --threshold\n"
-      "(sqrt(sigma_upper3 + sigma_lower3) at the smallest scale, see docs/edges.md), the noisy\n"
-      "network answers every other cloud. Both need the same classes and scales.\n"
-      "Example: glint edges gate noisy-3c.json clean-3c.json --threshold 0.01 -o gated-3c.json");
-  command->add_option("noisy", options->noisy, "Model for noisy clouds (e.g. trained with noise)")
+      "Join two BoundED networks into one gated model: the second network answers the clouds\n"
+      "the gate picks, the first every other cloud. Both need the same classes and scales.\n"
+      "  --statistic noise: a low-noise network answers a cloud when more than half of its\n"
+      "    points have a noise statistic below --threshold (sqrt(sigma_upper3 + sigma_lower3)\n"
+      "    at the smallest scale).\n"
+      "  --statistic sampling: a mesh-vertex network answers a cloud whose spacings spread\n"
+      "    like a tessellation's vertices: ln(P90 / P10) of the distance to the 8th nearest\n"
+      "    other point at least --threshold (about 0.45 on even samples).\n"
+      "See docs/edges.md, \"gate\".\n"
+      "Examples:\n"
+      "  glint edges gate noisy-3c.json clean-3c.json --threshold 0.01 -o gated-3c.json\n"
+      "  glint edges gate any-3c.json vertices-3c.json --statistic sampling --threshold 0.98 \\\n"
+      "      -o gated-3c.json");
+  command->add_option("model", options->model, "Model for the clouds the gate does not pick")
       ->required()
       ->check(CLI::ExistingFile);
-  command->add_option("low_noise", options->low_noise, "Model for low-noise clouds")
+  command->add_option("gate_model", options->gate_model, "Model for the clouds the gate picks")
       ->required()
       ->check(CLI::ExistingFile);
-  command->add_option("--threshold", options->threshold, "Noise statistic of a quiet point, > 0")
+  command->add_option("--statistic", options->statistic, "What the gate reads: noise or sampling")
+      ->capture_default_str();
+  command
+      ->add_option("--threshold", options->threshold,
+                   "Gate threshold, > 0 (noise statistic of a quiet point; spacing spread)")
       ->required();
   command->add_option("-o,--output", options->output, "Output model JSON")
       ->required()

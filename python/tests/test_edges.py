@@ -47,9 +47,12 @@ def test_classify_scales_and_model_options(cloud_file, cli, tmp_path):
 def test_classify_takes_a_noise_gated_model(cli, tmp_path):
     import json
     from conftest import REPO
-    shipped = REPO / "models/bounded-3c.json"
-    # A second network that differs from the shipped one: more weight on the boundary class.
-    network = json.loads(shipped.read_text())
+    # The shipped 3-class network without its sampling gate, and a second network that differs
+    # from it: more weight on the boundary class.
+    network = json.loads((REPO / "models/bounded-3c.json").read_text())
+    network.pop("sampling_gate", None)
+    shipped = tmp_path / "shipped.json"
+    shipped.write_text(json.dumps(network))
     network["layers"][-1]["bias"][2] += 4.0
     low_noise = tmp_path / "low-noise.json"
     low_noise.write_text(json.dumps(network))

@@ -37,13 +37,13 @@ std::vector<int> scales_for(const Model& model, const std::vector<int>& scales) 
 }
 
 // Computes the features once and runs every network on each block of them as it is computed,
-// so the rows are never all stored; one result per network. With `quiet`, also marks the points
-// whose noise statistic is below `threshold`. Each thread's time is split between the two
-// stages to report them apart.
+// so the rows are never all stored; one result per network. With `gate_values`, also every
+// point's value for the gate of `gate_kind`. Each thread's time is split between the two stages
+// to report them apart.
 std::vector<Classification> run_networks(const PointCloud& cloud,
                                          const std::vector<const Model*>& networks,
-                                         const std::vector<int>& scales, float threshold,
-                                         std::vector<std::uint8_t>* quiet) {
+                                         const std::vector<int>& scales, GateKind gate_kind,
+                                         std::vector<float>* gate_values) {
   FeatureParams params = networks.front()->config.feature_params();
   params.scales = scales;
   const int scale_count = static_cast<int>(scales.size());
@@ -52,7 +52,8 @@ std::vector<Classification> run_networks(const PointCloud& cloud,
   const std::size_t classes = static_cast<std::size_t>(networks.front()->config.classes);
   std::vector<Classification> results;
   for (std::size_t n = 0; n < networks.size(); ++n) results.push_back(sized_result(cloud.size()));
-  if (quiet) quiet->assign(cloud.size(), 0);
+  const bool noise_values = gate_values && gate_kind == GateKind::noise;
+  if (noise_values) gate_values->resize(cloud.size());
 
   struct Worker {
     Model::PredictScratch scratch;
@@ -82,12 +83,13 @@ std::vector<Classification> run_networks(const PointCloud& cloud,
                                classes);
           }
         }
-        if (quiet)
+        if (noise_values)
           for (std::size_t b = 0; b < count; ++b)
-            (*quiet)[points[b]] =
-                noise_statistic(rows + b * row_size, scale_count, per_scale) < threshold;
+            (*gate_values)[points[b]] =
+                noise_statistic(rows + b * row_size, scale_count, per_scale);
         worker.network_s += network_watch.elapsed_s();
-      });
+      },
+      gate_values && gate_kind == GateKind::sampling ? gate_values : nullptr);
   const double total_s = watch.elapsed_s();
   double network_s = 0;
   for (const Worker& worker : workers) network_s += worker.network_s;
@@ -99,22 +101,31 @@ std::vector<Classification> run_networks(const PointCloud& cloud,
   return results;
 }
 
-std::uint64_t count_quiet(const std::vector<std::uint8_t>& quiet) {
-  return static_cast<std::uint64_t>(std::count(quiet.begin(), quiet.end(), std::uint8_t(1)));
+// The gate's tally of every point's value.
+GateTally tally_of(const Model& model, const std::vector<float>& gate_values) {
+  GateTally tally = model.new_tally();
+  for (const float value : gate_values) tally.add(value);
+  return tally;
+}
+
+// Records the gate's statistic and choice in a result.
+void keep_gate_choice(Classification& result, const GateTally& tally) {
+  result.gate_statistic = tally.statistic();
+  result.gate_network_answered = tally.gate_network_answers();
 }
 
 }  // namespace
 
 GatedClassification classify_gated(const PointCloud& cloud, const Model& model,
                                    const std::vector<int>& scales) {
-  if (!model.gated()) throw Error("model", "noise_gate", "the model has no noise gate");
+  if (!model.gated()) throw Error("model", "gate", "the model has no gate");
   model.check();
   GatedClassification result;
   std::vector<Classification> both =
-      run_networks(cloud, {&model, model.low_noise.get()}, scales_for(model, scales),
-                   model.noise_threshold, &result.quiet);
-  result.noisy = std::move(both[0]);
-  result.low_noise = std::move(both[1]);
+      run_networks(cloud, {&model, model.gate_network.get()}, scales_for(model, scales),
+                   model.gate_kind, &result.gate_values);
+  result.model_network = std::move(both[0]);
+  result.gate_network = std::move(both[1]);
   return result;
 }
 
@@ -122,14 +133,14 @@ Classification classify(const PointCloud& cloud, const Model& model,
                         const std::vector<int>& scales) {
   if (!model.gated()) {
     model.check();
-    return std::move(run_networks(cloud, {&model}, scales_for(model, scales), 0, nullptr)[0]);
+    return std::move(
+        run_networks(cloud, {&model}, scales_for(model, scales), model.gate_kind, nullptr)[0]);
   }
   GatedClassification both = classify_gated(cloud, model, scales);
-  const std::uint64_t quiet = count_quiet(both.quiet);
-  const bool low_noise = Model::low_noise_answers(quiet, cloud.size());
-  Classification result = std::move(low_noise ? both.low_noise : both.noisy);
-  result.quiet_points = quiet;
-  result.low_noise_network = low_noise;
+  const GateTally tally = tally_of(model, both.gate_values);
+  Classification result =
+      std::move(tally.gate_network_answers() ? both.gate_network : both.model_network);
+  keep_gate_choice(result, tally);
   return result;
 }
 
@@ -138,11 +149,18 @@ Classification classify_features(const FeatureMatrix& features, const Model& mod
   const Model* network = &model;
   if (model.gated()) {
     model.check_features(features);
-    for (std::size_t i = 0; i < features.points; ++i)
-      result.quiet_points += noise_statistic(features.row(i), features.scales, features.per_scale) <
-                             model.noise_threshold;
-    result.low_noise_network = Model::low_noise_answers(result.quiet_points, features.points);
-    if (result.low_noise_network) network = model.low_noise.get();
+    GateTally tally = model.new_tally();
+    if (model.gate_kind == GateKind::noise) {
+      for (std::size_t i = 0; i < features.points; ++i)
+        tally.add(noise_statistic(features.row(i), features.scales, features.per_scale));
+    } else {
+      if (features.squared_spacings.size() != features.points)
+        throw Error("features", "squared_spacings",
+                    "a sampling gate needs every point's spacing (compute_features)");
+      for (const float value : features.squared_spacings) tally.add(value);
+    }
+    keep_gate_choice(result, tally);
+    if (result.gate_network_answered) network = model.gate_network.get();
   }
   const Stopwatch watch;
   std::vector<float> probabilities;

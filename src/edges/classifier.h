@@ -17,28 +17,27 @@ struct Classification {
   // between them in proportion to the thread time each took.
   double features_s = 0;
   double inference_s = 0;
-  // A noise-gated model (Model::gated): the points whose noise statistic is below the gate's
-  // threshold, and whether the gate's low-noise network answered (Model::low_noise_answers).
-  std::uint64_t quiet_points = 0;
-  bool low_noise_network = false;
+  // A gated model (Model::gated): the cloud's gate statistic (GateTally::statistic) and
+  // whether the gate's network answered.
+  double gate_statistic = 0;
+  bool gate_network_answered = false;
 };
 
 // Classifies every point. `scales` overrides the model's neighbourhood sizes (same count;
 // e.g. for a much denser or sparser cloud than the training data); empty = the model's.
-// A noise-gated model runs both of its networks on the features and keeps one for the whole
-// cloud.
+// A gated model runs both of its networks on the features and keeps one for the whole cloud.
 Classification classify(const PointCloud& cloud, const Model& model,
                         const std::vector<int>& scales = {});
 // The network part alone, on features computed at the model's scale count (several models
 // with the same scales can share one feature matrix); features_s stays 0.
 Classification classify_features(const FeatureMatrix& features, const Model& model);
 
-// Both answers of a noise-gated model for every point, the choice left open (tiled
-// classification makes it once for the whole file, from every tile's core points).
+// Both answers of a gated model for every point, the choice left open (tiled classification
+// makes it once for the whole file, from every tile's core points).
 struct GatedClassification {
-  Classification noisy;             // the model's own network
-  Classification low_noise;         // the gate's network
-  std::vector<std::uint8_t> quiet;  // 1 where the point's noise statistic is below the gate
+  Classification model_network;    // the model's own network
+  Classification gate_network;     // the gate's network
+  std::vector<float> gate_values;  // each point's value for GateTally::add
 };
 // Throws glint::Error for a model without a gate, and as classify().
 GatedClassification classify_gated(const PointCloud& cloud, const Model& model,

@@ -414,11 +414,13 @@ std::vector<float> squared_spacings(const PointCloud& cloud,
 }
 
 // Every point's features, written to row_for(point, scratch); row_written(scratch) follows
-// on the same thread. The cloud must have passed check_cloud.
+// on the same thread. With `spacings_out` (one entry per point), also each point's squared
+// distance to its kAreaSpacingNeighbour-th nearest other point, read off its sorted
+// neighbourhood. The cloud must have passed check_cloud.
 template <class RowFor, class RowWritten>
 void compute_rows(const PointCloud& cloud, const FeatureParams& params,
                   tbb::enumerable_thread_specific<Scratch>& scratches, RowFor&& row_for,
-                  RowWritten&& row_written) {
+                  RowWritten&& row_written, float* spacings_out) {
   const PointKernel kernel = point_kernel();
   geometry::NeighbourhoodParams search_params;
   search_params.k = params.scales[0];
@@ -432,6 +434,10 @@ void compute_rows(const PointCloud& cloud, const FeatureParams& params,
         Scratch& scratch = scratches.local();
         kernel(nb, params, scratch, row_for(nb.point, scratch));
         row_written(scratch);
+        if (spacings_out) {
+          const int j = std::min(kAreaSpacingNeighbour, nb.size - 1);
+          spacings_out[nb.point] = nb.dx[j] * nb.dx[j] + nb.dy[j] * nb.dy[j] + nb.dz[j] * nb.dz[j];
+        }
       },
       [&](std::size_t done) { progress.advance(done); }, spacings);
   log().debug(
@@ -449,17 +455,20 @@ FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& par
   features.scales = static_cast<int>(params.scales.size());
   features.per_scale = params.per_scale();
   features.values.resize(features.points * features.row_size());
+  features.squared_spacings.resize(features.points);
   tbb::enumerable_thread_specific<Scratch> scratches;
   compute_rows(
       cloud, params, scratches, [&](std::uint32_t point, Scratch&) { return features.row(point); },
-      [](Scratch&) {});
+      [](Scratch&) {}, features.squared_spacings.data());
   return features;
 }
 
 void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& params,
-                                std::size_t block_size, const FeatureBlockConsumer& consume) {
+                                std::size_t block_size, const FeatureBlockConsumer& consume,
+                                std::vector<float>* squared_spacings) {
   check_cloud(cloud, params);
   if (block_size == 0) throw Error("", "block size", "must be at least 1");
+  if (squared_spacings) squared_spacings->resize(cloud.size());
   const std::size_t row_size = params.row_size();
   tbb::enumerable_thread_specific<Scratch> scratches([&] {
     Scratch scratch;
@@ -477,7 +486,8 @@ void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& pa
         if (scratch.block_points.size() < block_size) return;
         consume(scratch.block_points.data(), scratch.block_rows.data(), block_size);
         scratch.block_points.clear();
-      });
+      },
+      squared_spacings ? squared_spacings->data() : nullptr);
   // Each thread's last, partial block.
   for (Scratch& scratch : scratches) {
     if (scratch.block_points.empty()) continue;

@@ -71,6 +71,9 @@ struct FeatureMatrix {
   int scales = 0;
   int per_scale = kThesisFeaturesPerScale;
   std::vector<float> values;
+  // Per point, the squared distance to its kAreaSpacingNeighbour-th nearest other point: the
+  // local spacing the sampling gate of edges/model.h reads.
+  std::vector<float> squared_spacings;
 
   std::size_t row_size() const { return static_cast<std::size_t>(scales) * per_scale; }
   const float* row(std::size_t point) const { return values.data() + point * row_size(); }
@@ -88,11 +91,13 @@ FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& par
 // The same features handed over in blocks as they are computed, never all stored (a 1M-point
 // cloud's rows are 192 MB): consume(points, rows, count) gets up to block_size point indices
 // and their rows (row-major, scales·per_scale floats each), from several threads at once; every
-// point comes in exactly one block. Same checks and errors as compute_features.
+// point comes in exactly one block. Same checks and errors as compute_features. With
+// `squared_spacings`, also every point's FeatureMatrix::squared_spacings value.
 using FeatureBlockConsumer =
     std::function<void(const std::uint32_t* points, const float* rows, std::size_t count)>;
 void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& params,
-                                std::size_t block_size, const FeatureBlockConsumer& consume);
+                                std::size_t block_size, const FeatureBlockConsumer& consume,
+                                std::vector<float>* squared_spacings = nullptr);
 
 // The noise statistic of one point, from its feature row (`scales` scales of `per_scale`
 // values each): at the smallest scale, sqrt(sigma_upper(3) + sigma_lower(3)), the spread of

@@ -14,6 +14,14 @@
 namespace glint::edges {
 namespace {
 
+// The model file's key of a gate and of its network.
+std::string gate_key(GateKind kind) {
+  return kind == GateKind::noise ? "noise_gate" : "sampling_gate";
+}
+const char* gate_network_key(GateKind kind) {
+  return kind == GateKind::noise ? "low_noise" : "mesh_vertices";
+}
+
 constexpr const char* kFormatName = "glint-bounded-model";
 constexpr int kFormatVersion = 1;
 constexpr std::size_t kBatch = Model::kBatch;
@@ -138,26 +146,71 @@ void Model::check() const {
                               shape.outputs));
   }
   if (gated()) {
-    if (low_noise->gated()) throw Error(where, "noise_gate", "the gate's network has a gate");
-    if (low_noise->config.classes != config.classes ||
-        low_noise->config.feature_params() != config.feature_params() ||
-        low_noise->layers.size() != layers.size())
-      throw Error(where, "noise_gate.low_noise",
+    const std::string key = gate_key(gate_kind);
+    if (gate_network->gated()) throw Error(where, key, "the gate's network has a gate");
+    if (gate_network->config.classes != config.classes ||
+        gate_network->config.feature_params() != config.feature_params() ||
+        gate_network->layers.size() != layers.size())
+      throw Error(where, key + "." + gate_network_key(gate_kind),
                   "the gate's network must have the same classes, scales, inputs and layers");
-    low_noise->check();
-    if (!std::isfinite(noise_threshold) || noise_threshold <= 0.0f)
-      throw Error(where, "noise_gate.threshold",
-                  fmt::format("must be finite and > 0, got {}", noise_threshold));
+    gate_network->check();
+    if (!std::isfinite(gate_threshold) || gate_threshold <= 0.0f)
+      throw Error(where, key + ".threshold",
+                  fmt::format("must be finite and > 0, got {}", gate_threshold));
   }
 }
 
-Model Model::with_noise_gate(Model low_noise_network, float threshold) const {
-  if (gated()) throw Error("model", "noise_gate", "already has a noise gate");
+Model Model::with_gate(GateKind kind, Model network, float threshold) const {
+  if (gated()) throw Error("model", gate_key(gate_kind), "already has a gate");
   Model gated_model = *this;
-  gated_model.low_noise = std::make_shared<const Model>(std::move(low_noise_network));
-  gated_model.noise_threshold = threshold;
+  gated_model.gate_network = std::make_shared<const Model>(std::move(network));
+  gated_model.gate_kind = kind;
+  gated_model.gate_threshold = threshold;
   gated_model.check();
   return gated_model;
+}
+
+const char* Model::network_name(bool gate_network_answered) const {
+  if (gate_kind == GateKind::noise) return gate_network_answered ? "low-noise" : "noisy";
+  return gate_network_answered ? "mesh-vertex" : "default";
+}
+
+GateTally::GateTally(GateKind kind, float threshold)
+    : kind_(kind),
+      threshold_(threshold),
+      counts_(kind == GateKind::sampling ? 2 + 2 * kLogRange * kBinsPerUnit : 2, 0) {}
+
+void GateTally::add(float value) {
+  ++counts_[0];
+  if (kind_ == GateKind::noise) {
+    counts_[1] += value < threshold_;
+    return;
+  }
+  // ln r = ln(r^2) / 2; a duplicate point's spacing 0 falls in the lowest bin.
+  const double bin = (0.5 * std::log(double(value)) + kLogRange) * kBinsPerUnit;
+  const auto bins = static_cast<double>(counts_.size() - 2);
+  ++counts_[2 + static_cast<std::size_t>(std::clamp(bin, 0.0, bins - 1))];
+}
+
+double GateTally::statistic() const {
+  const std::uint64_t n = points();
+  if (n == 0) return 0;
+  if (kind_ == GateKind::noise) return double(counts_[1]) / double(n);
+  // The centre of the bin in which the sorted values reach rank ceil(q n).
+  const auto percentile = [&](double q) {
+    const auto rank = std::max<std::uint64_t>(1, std::uint64_t(std::ceil(q * double(n))));
+    std::uint64_t seen = 0;
+    std::size_t bin = 2;
+    for (; bin + 1 < counts_.size(); ++bin)
+      if ((seen += counts_[bin]) >= rank) break;
+    return (double(bin - 2) + 0.5) / kBinsPerUnit - kLogRange;
+  };
+  return percentile(0.9) - percentile(0.1);
+}
+
+bool GateTally::gate_network_answers() const {
+  if (kind_ == GateKind::noise) return 2 * counts_[1] > points();
+  return points() > 0 && statistic() >= threshold_;
 }
 
 namespace {
@@ -237,10 +290,14 @@ nlohmann::json Model::to_json() const {
                          {"hidden_layers", config.hidden_layers},
                          {"leaky_slope", io::exact_float(config.leaky_slope)}};
   root.update(network_json(*this));
-  if (gated())
-    root["noise_gate"] = {{"statistic", "sqrt(sigma_upper(3) + sigma_lower(3)), smallest scale"},
-                          {"threshold", io::exact_float(noise_threshold)},
-                          {"low_noise", network_json(*low_noise)}};
+  if (gated()) {
+    const char* statistic = gate_kind == GateKind::noise
+                                ? "sqrt(sigma_upper(3) + sigma_lower(3)), smallest scale"
+                                : "ln(P90 / P10) of the distance to the 8th nearest other point";
+    root[gate_key(gate_kind)] = {{"statistic", statistic},
+                                 {"threshold", io::exact_float(gate_threshold)},
+                                 {gate_network_key(gate_kind), network_json(*gate_network)}};
+  }
   return root;
 }
 
@@ -289,14 +346,19 @@ Model Model::load(const std::string& path) {
 
   Model model(config);
   read_network(reader, root, "", model);
-  if (const auto gate = root.find("noise_gate"); gate != root.end()) {
-    if (!gate->is_object()) reader.fail("noise_gate", "expected an object");
-    Model low_noise(config);
-    read_network(reader, reader.member(*gate, "low_noise", "noise_gate"), "noise_gate.low_noise",
-                 low_noise);
-    model.noise_threshold = reader.finite_float(reader.member(*gate, "threshold", "noise_gate"),
-                                                "noise_gate.threshold");
-    model.low_noise = std::make_shared<const Model>(std::move(low_noise));
+  for (const GateKind kind : {GateKind::noise, GateKind::sampling}) {
+    const std::string key = gate_key(kind);
+    const auto gate = root.find(key);
+    if (gate == root.end()) continue;
+    if (model.gated()) reader.fail(key, "a model holds one gate; this one has two");
+    if (!gate->is_object()) reader.fail(key, "expected an object");
+    const std::string network_key = key + "." + gate_network_key(kind);
+    Model network(config);
+    read_network(reader, reader.member(*gate, gate_network_key(kind), key), network_key, network);
+    model.gate_threshold =
+        reader.finite_float(reader.member(*gate, "threshold", key), key + ".threshold");
+    model.gate_kind = kind;
+    model.gate_network = std::make_shared<const Model>(std::move(network));
     try {
       model.check();
     } catch (const Error& e) {

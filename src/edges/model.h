@@ -16,10 +16,9 @@
 //
 // Classes: index = glint point label: 0 non-edge, 1 sharp edge, 2 boundary (C = 3 only).
 //
-// A model file may hold a noise gate: a second network of the same config, trained on clean
-// clouds, that answers a whole cloud instead of the first when more than half of the cloud's
-// points have a noise statistic (edges::noise_statistic) below the gate's threshold
-// (docs/edges.md, "gate").
+// A model file may hold a gate: a second network of the same config that answers a whole cloud
+// instead of the first when the cloud's gate statistic says so (GateKind; docs/edges.md,
+// "gate").
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -64,6 +63,42 @@ struct DenseLayer {
 // then the hidden layers; then the output layer), with zero weights.
 std::vector<DenseLayer> make_layers(const ModelConfig& config);
 
+// What a gate reads from each point and when its network answers the whole cloud.
+enum class GateKind {
+  // More than half of the points have edges::noise_statistic below the threshold: a network
+  // trained on clean clouds.
+  noise,
+  // The spread of the points' spacings, ln(P90 / P10) of the distance to the
+  // kAreaSpacingNeighbour-th nearest other point, is at least the threshold: a network trained
+  // on the mesh vertices of tessellations (dense along feature curves, sparse on planes).
+  sampling,
+};
+
+// A gate's evidence summed over the points of a cloud, or over the core points of every tile
+// of a file (counts add across tiles and ranks, so the choice is the whole file's).
+class GateTally {
+ public:
+  // ln r of the sampling gate in bins of 1/kBinsPerUnit over [-kLogRange, kLogRange).
+  static constexpr int kBinsPerUnit = 64;
+  static constexpr int kLogRange = 40;
+
+  GateTally(GateKind kind, float threshold);
+  // One point's value: its noise statistic or its squared spacing (FeatureMatrix).
+  void add(float value);
+  // The counts to sum across ranks: points, quiet points, spacing bins.
+  std::vector<std::uint64_t>& counts() { return counts_; }
+  std::uint64_t points() const { return counts_[0]; }
+  // Noise gate: the share of quiet points. Sampling gate: ln(P90 / P10) of the spacings, each
+  // percentile the centre of the bin where the sorted points reach it.
+  double statistic() const;
+  bool gate_network_answers() const;
+
+ private:
+  GateKind kind_;
+  float threshold_;
+  std::vector<std::uint64_t> counts_;
+};
+
 class Model {
  public:
   // A network of the given config with zero weights, mean 0 and std 1 (call check_config first
@@ -76,18 +111,17 @@ class Model {
   std::vector<DenseLayer> layers;  // see make_layers
   nlohmann::json training_info = nlohmann::json::object();  // free-form: how it was trained
 
-  // The noise gate (none when low_noise is null): low_noise has this config and no gate.
-  std::shared_ptr<const Model> low_noise;
-  float noise_threshold = 0;  // > 0, in units of edges::noise_statistic
-  bool gated() const { return low_noise != nullptr; }
-  // Whether the low-noise network answers a cloud of `points` points of which `quiet` have a
-  // noise statistic below the threshold: more than half of them.
-  static bool low_noise_answers(std::uint64_t quiet, std::uint64_t points) {
-    return 2 * quiet > points;
-  }
-  // This model with `low_noise` as its gate's network (checks that the configs match and the
-  // threshold is finite and > 0; throws glint::Error).
-  Model with_noise_gate(Model low_noise_network, float threshold) const;
+  // The gate (none when gate_network is null): gate_network has this config and no gate.
+  std::shared_ptr<const Model> gate_network;
+  GateKind gate_kind = GateKind::noise;
+  float gate_threshold = 0;  // > 0, in the units of the gate's statistic (GateTally)
+  bool gated() const { return gate_network != nullptr; }
+  GateTally new_tally() const { return GateTally(gate_kind, gate_threshold); }
+  // The names of the model's own network and of the gate's, for logs and reports.
+  const char* network_name(bool gate_network_answered) const;
+  // This model with `network` behind a gate (checks that the configs match and the threshold is
+  // finite and > 0; throws glint::Error).
+  Model with_gate(GateKind kind, Model network, float threshold) const;
 
   static constexpr float kMinInputStd = 1e-6f;
 

@@ -423,8 +423,8 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
     } catch (const Error& e) {
       throw Error(input, e.element(), e.reason());
     }
-    stats.quiet_points = result.quiet_points;
-    stats.low_noise_network = result.low_noise_network;
+    stats.gate_statistic = result.gate_statistic;
+    stats.gate_network_answered = result.gate_network_answered;
     stats.classify_s = watch.elapsed_s();
     cloud = PointCloud();
     watch.restart();
@@ -614,6 +614,7 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
   const std::size_t record_bytes = model.gated() ? 2 * kResultBytes : kResultBytes;
   std::uint64_t rank_points = 0;
   for (const std::size_t t : mine) rank_points += tile_core[t];
+  GateTally tally = model.new_tally();
   stats.rank_points = rank_points;
   stats.rank_tiles = mine.size();
   {
@@ -648,7 +649,7 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
         if (model.gated()) {
           result = classify_gated(cloud, model, scales);
         } else {
-          result.noisy = classify(cloud, model, scales);
+          result.model_network = classify(cloud, model, scales);
         }
       } catch (const Error& e) {
         set_quiet(was_quiet);
@@ -660,10 +661,10 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
       for (std::size_t i = 0; i < cloud.size(); ++i) {
         if (!core[i]) continue;
         std::uint8_t record[2 * kResultBytes];
-        put_result(result.noisy, i, record);
+        put_result(result.model_network, i, record);
         if (model.gated()) {
-          put_result(result.low_noise, i, record + kResultBytes);
-          stats.quiet_points += result.quiet[i];
+          put_result(result.gate_network, i, record + kResultBytes);
+          tally.add(result.gate_values[i]);
         }
         write_all(results.get(), record, record_bytes, result_path.string());
       }
@@ -678,12 +679,11 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
   }
   stats.classify_s = watch.elapsed_s();
   if (model.gated()) {  // one choice of network for the whole file
-    std::vector<std::uint64_t> quiet{stats.quiet_points};
-    world.sum(quiet);
-    stats.quiet_points = quiet[0];
-    stats.low_noise_network = Model::low_noise_answers(stats.quiet_points, n);
+    world.sum(tally.counts());
+    stats.gate_statistic = tally.statistic();
+    stats.gate_network_answered = tally.gate_network_answers();
   }
-  const std::size_t result_offset = stats.low_noise_network ? kResultBytes : 0;
+  const std::size_t result_offset = stats.gate_network_answered ? kResultBytes : 0;
   world.barrier();
 
   // Pass 4: the output, in input order; each point takes the next result of its core tile.

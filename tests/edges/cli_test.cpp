@@ -145,21 +145,27 @@ TEST_F(CliTest, GateJoinsTwoNetworksAndClassifyReportsItsChoice) {
   const std::string models = std::string(GLINT_TEST_DATA_DIR) + "/../../models/";
   const std::string three = models + "bounded-3c.json", two = models + "bounded-2c.json";
   CommandResult run =
-      glint("edges gate " + three + " " + two + " --threshold 0.1 -o " + path("never.json"));
+      glint("edges gate " + two + " " + three + " --threshold 0.1 -o " + path("never.json"));
   EXPECT_EQ(run.exit_code, 1);
-  EXPECT_NE(run.output.find("bounded-2c.json"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("bounded-3c.json"), std::string::npos) << run.output;
   EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << run.output;
-  run = glint("edges gate " + three + " " + three + " --threshold 0 -o " + path("never.json"));
+  run = glint("edges gate " + two + " " + two + " --threshold 0 -o " + path("never.json"));
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.output.find("--threshold"), std::string::npos) << run.output;
-  EXPECT_FALSE(fs::exists(path("never.json")));
-
-  run = glint("edges gate " + three + " " + three + " --threshold 0.1 -o " + path("gated.json"));
-  ASSERT_EQ(run.exit_code, 0) << run.output;
-  run = glint("edges gate " + path("gated.json") + " " + three + " --threshold 0.1 -o " +
+  run = glint("edges gate " + two + " " + two + " --statistic density --threshold 1 -o " +
               path("never.json"));
   EXPECT_EQ(run.exit_code, 1);
-  EXPECT_NE(run.output.find("already has a noise gate"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("--statistic"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(path("never.json")));
+
+  run = glint("edges gate " + two + " " + two + " --threshold 0.1 -o " + path("gated.json"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  // The shipped 3-class model already has its sampling gate.
+  for (const std::string& gated : {path("gated.json"), three}) {
+    run = glint("edges gate " + gated + " " + two + " --threshold 0.1 -o " + path("never.json"));
+    EXPECT_EQ(run.exit_code, 1);
+    EXPECT_NE(run.output.find("already has a gate"), std::string::npos) << run.output;
+  }
 
   run = glint("edges synth -o " + path("clouds") +
               " --count 1 --seed 5 --min-points 1500 --max-points 2500 --shapes box --noise 0 "
@@ -172,8 +178,17 @@ TEST_F(CliTest, GateJoinsTwoNetworksAndClassifyReportsItsChoice) {
               path("gated.json") + " --report " + path("classify.json"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const auto report = nlohmann::json::parse(std::ifstream(path("classify.json")));
-  EXPECT_EQ(report["noise_gate"]["network"], "low-noise") << report.dump();
-  EXPECT_EQ(report["noise_gate"]["threshold"], 0.1f);
+  EXPECT_EQ(report["gate"]["kind"], "noise") << report.dump();
+  EXPECT_EQ(report["gate"]["network"], "low-noise") << report.dump();
+  EXPECT_EQ(report["gate"]["threshold"], 0.1f);
+
+  // The shipped 3-class model's sampling gate keeps an even sample on its default network.
+  run = glint("edges classify " + cloud + " -o " + path("out.ply") + " --model " + three +
+              " --report " + path("classify.json"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const auto shipped = nlohmann::json::parse(std::ifstream(path("classify.json")));
+  EXPECT_EQ(shipped["gate"]["kind"], "sampling") << shipped.dump();
+  EXPECT_EQ(shipped["gate"]["network"], "default") << shipped.dump();
 }
 
 // --png into a missing folder failed after OUT.ply was written, leaving it behind; now the

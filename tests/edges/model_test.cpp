@@ -349,9 +349,9 @@ TEST_F(MalformedModelTest, WrongValues) {
   expect_rejected([](nlohmann::json& j) { j["neighbour_weights"] = 1; }, "neighbour_weights");
 }
 
-TEST_F(MalformedModelTest, BrokenNoiseGates) {
+TEST_F(MalformedModelTest, BrokenGates) {
   const nlohmann::json gated = random_model(ModelConfig{}, 3)
-                                   .with_noise_gate(random_model(ModelConfig{}, 4), 0.1f)
+                                   .with_gate(GateKind::noise, random_model(ModelConfig{}, 4), 0.1f)
                                    .to_json();
   auto rejects = [&](auto damage, const std::string& element) {
     expect_rejected(damage, element, gated);
@@ -366,6 +366,17 @@ TEST_F(MalformedModelTest, BrokenNoiseGates) {
           "noise_gate.low_noise.input_std[0]");
   rejects([](nlohmann::json& j) { j["noise_gate"]["low_noise"]["parameter_count"] = 7; },
           "noise_gate.low_noise.parameter_count");
+  // A sampling gate names its network mesh_vertices; a file holds one gate.
+  const nlohmann::json by_sampling =
+      random_model(ModelConfig{}, 3)
+          .with_gate(GateKind::sampling, random_model(ModelConfig{}, 4), 0.98f)
+          .to_json();
+  expect_rejected([](nlohmann::json& j) { j["sampling_gate"].erase("mesh_vertices"); },
+                  "sampling_gate.mesh_vertices", by_sampling);
+  expect_rejected([](nlohmann::json& j) { j["sampling_gate"]["threshold"] = 0; },
+                  "sampling_gate.threshold", by_sampling);
+  expect_rejected([&](nlohmann::json& j) { j["noise_gate"] = gated["noise_gate"]; },
+                  "sampling_gate", by_sampling);
 }
 
 TEST_F(MalformedModelTest, NotJsonOrNoFile) {

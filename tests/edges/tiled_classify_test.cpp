@@ -23,9 +23,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The shipped 3-class model's own network, its sampling gate left out: tests add gates of
+// their own.
 const Model& bounded_model() {
-  static const Model model =
-      Model::load(std::string(GLINT_TEST_DATA_DIR) + "/../../models/bounded-3c.json");
+  static const Model model = [] {
+    Model shipped = Model::load(std::string(GLINT_TEST_DATA_DIR) + "/../../models/bounded-3c.json");
+    shipped.gate_network = nullptr;
+    return shipped;
+  }();
   return model;
 }
 
@@ -193,9 +198,9 @@ TEST_F(TiledClassify, AGatedModelChoosesOneNetworkForTheWholeFileInTilesToo) {
   write_scene(path("scene.las"), origin);
   Model low_noise = bounded_model();
   low_noise.layers.back().bias[2] += 4.0f;  // a network that calls far more points boundary
-  const Model gated = bounded_model().with_noise_gate(low_noise, 0.1f);
+  const Model gated = bounded_model().with_gate(GateKind::noise, low_noise, 0.1f);
   const TiledClassifyStats whole = classify_las(path("scene.las"), path("whole.las"), gated);
-  EXPECT_TRUE(whole.low_noise_network);  // clean shapes on a flat ground
+  EXPECT_TRUE(whole.gate_network_answered);  // clean shapes on a flat ground
   classify_las(path("scene.las"), path("alone.las"), low_noise);
   const OutputDifference as_alone = compare_outputs(path("whole.las"), path("alone.las"));
   EXPECT_EQ(as_alone.labels, 0u);
@@ -206,8 +211,8 @@ TEST_F(TiledClassify, AGatedModelChoosesOneNetworkForTheWholeFileInTilesToo) {
   const TiledClassifyStats tiled =
       classify_las(path("scene.las"), path("tiled.las"), gated, params);
   EXPECT_TRUE(tiled.tiled);
-  EXPECT_TRUE(tiled.low_noise_network);
-  EXPECT_NEAR(double(tiled.quiet_points), double(whole.quiet_points), whole.points / 100.0);
+  EXPECT_TRUE(tiled.gate_network_answered);
+  EXPECT_NEAR(tiled.gate_statistic, whole.gate_statistic, 0.01);
   const OutputDifference difference = compare_outputs(path("whole.las"), path("tiled.las"));
   EXPECT_TRUE(difference.other_bytes_equal);
   EXPECT_EQ(difference.labels, 0u);
@@ -216,10 +221,35 @@ TEST_F(TiledClassify, AGatedModelChoosesOneNetworkForTheWholeFileInTilesToo) {
   write_scene(path("noisy-scene.las"), origin, 0.1);
   const TiledClassifyStats noisy =
       classify_las(path("noisy-scene.las"), path("noisy.las"), gated, params);
-  EXPECT_FALSE(noisy.low_noise_network);
+  EXPECT_FALSE(noisy.gate_network_answered);
   classify_las(path("noisy-scene.las"), path("ungated.las"), bounded_model(), params);
   EXPECT_EQ(compare_outputs(path("noisy.las"), path("ungated.las")).labels, 0u);
   EXPECT_EQ(compare_outputs(path("noisy.las"), path("ungated.las")).probabilities, 0u);
+}
+
+// A sampling gate's spread comes from every tile's core points: the whole file's, in tiles too.
+TEST_F(TiledClassify, ASamplingGateReadsTheWholeFilesSpacingsInTiles) {
+  const double origin[3] = {0, 0, 0};
+  write_scene(path("scene.las"), origin);
+  Model mesh_vertex = bounded_model();
+  mesh_vertex.layers.back().bias[2] += 4.0f;
+  // Thresholds just below and far above the scene's spread: each network answers once.
+  const Model probe = bounded_model().with_gate(GateKind::sampling, mesh_vertex, 100.0f);
+  const TiledClassifyStats spread = classify_las(path("scene.las"), path("probe.las"), probe);
+  ASSERT_GT(spread.gate_statistic, 0.1);
+  for (const float threshold : {float(spread.gate_statistic) - 0.05f, 100.0f}) {
+    const Model gated = bounded_model().with_gate(GateKind::sampling, mesh_vertex, threshold);
+    const TiledClassifyStats whole = classify_las(path("scene.las"), path("whole.las"), gated);
+    TiledClassifyParams params;
+    params.tile_points = 9000;
+    const TiledClassifyStats tiled =
+        classify_las(path("scene.las"), path("tiled.las"), gated, params);
+    EXPECT_TRUE(tiled.tiled);
+    EXPECT_EQ(whole.gate_network_answered, threshold < 100.0f);
+    EXPECT_EQ(tiled.gate_network_answered, whole.gate_network_answered);
+    EXPECT_NEAR(tiled.gate_statistic, whole.gate_statistic, 1.0 / GateTally::kBinsPerUnit);
+    EXPECT_EQ(compare_outputs(path("whole.las"), path("tiled.las")).labels, 0u);
+  }
 }
 
 TEST_F(TiledClassify, FarFromTheOriginClassifiesExactlyAsAtTheOrigin) {
