@@ -186,10 +186,10 @@ void GateTally::add(float value) {
     counts_[1] += value < threshold_;
     return;
   }
-  // ln r = ln(r^2) / 2; a duplicate point's spacing 0 falls in the lowest bin.
+  // ln r = ln(r^2) / 2; a duplicate point's spacing 0 (and a NaN) falls in the lowest bin.
   const double bin = (0.5 * std::log(double(value)) + kLogRange) * kBinsPerUnit;
-  const auto bins = static_cast<double>(counts_.size() - 2);
-  ++counts_[2 + static_cast<std::size_t>(std::clamp(bin, 0.0, bins - 1))];
+  const auto last = static_cast<double>(counts_.size() - 3);
+  ++counts_[2 + static_cast<std::size_t>(bin >= 0.0 ? std::min(bin, last) : 0.0)];
 }
 
 double GateTally::statistic() const {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <random>
 
 #include "core/error.h"
@@ -144,6 +145,8 @@ TEST(SamplingGate, SpreadIsTheNinetiethLessTheTenthPercentileOfLnSpacing) {
   EXPECT_EQ(even.statistic(), 0.0);
   EXPECT_FALSE(even.gate_network_answers());
   even.add(0.0f);  // a duplicate point: the lowest bin, no NaN
+  even.add(std::nanf(""));
+  even.add(std::numeric_limits<float>::infinity());
   EXPECT_TRUE(std::isfinite(even.statistic()));
   EXPECT_FALSE(GateTally(GateKind::sampling, 0.5f).gate_network_answers());  // no points
 }
