@@ -31,7 +31,19 @@ struct ClassifyOptions {
   std::string method = "bounded";
   std::string memory_limit;
   std::uint64_t tile_points = 0;
+  bool no_gate = false;
 };
+
+std::string model_path(const ClassifyOptions& options) {
+  return options.model.empty() ? default_edges_model() : options.model;
+}
+
+// The model of --model (or the shipped one); under --no-gate its first network alone.
+edges::Model load_model(const ClassifyOptions& options) {
+  edges::Model model = edges::Model::load(model_path(options));
+  if (options.no_gate) model.gate_network = nullptr;
+  return model;
+}
 
 // The angle-gap baseline as a Classification: labels 0 / 2, p_boundary 0 / 1, no sharp class.
 edges::Classification classify_angle_gap(const PointCloud& cloud) {
@@ -83,8 +95,7 @@ void run_classify_las(const ClassifyOptions& options) {
     throw Error(options.input, "--method",
                 "only the network classifies LAS input (use a PLY cloud)");
   }
-  const std::string model_path = options.model.empty() ? default_edges_model() : options.model;
-  const edges::Model model = edges::Model::load(model_path);
+  const edges::Model model = load_model(options);
   edges::TiledClassifyParams params;
   params.scales = options.scales;
   if (!params.scales.empty() && params.scales.size() != model.config.scales.size()) {
@@ -133,7 +144,7 @@ void run_classify_las(const ClassifyOptions& options) {
                    {{"command", command_line()},
                     {"input", options.input},
                     {"output", options.output},
-                    {"model", model_path},
+                    {"model", model_path(options)},
                     {"scales", options.scales.empty() ? model.config.scales : options.scales},
                     {"points", stats.points},
                     {"labels",
@@ -163,10 +174,9 @@ void run_classify(const ClassifyOptions& options) {
     throw Error(options.output, "", "the output must be a .ply file");
   }
   PointCloud cloud = io::read_point_cloud(options.input);
-  const std::string model_path = options.model.empty() ? default_edges_model() : options.model;
-  const edges::Model model = edges::Model::load(model_path);
+  const edges::Model model = load_model(options);
   log().info("{}: {} points; model {} ({} classes, scales {})", options.input, cloud.size(),
-             model_path, model.config.classes, fmt::join(model.config.scales, ","));
+             model_path(options), model.config.classes, fmt::join(model.config.scales, ","));
 
   edges::Classification result;
   try {
@@ -212,7 +222,7 @@ void run_classify(const ClassifyOptions& options) {
          {"input", options.input},
          {"output", options.output},
          {"method", options.method},
-         {"model", model_path},
+         {"model", model_path(options)},
          {"scales", options.scales.empty() ? model.config.scales : options.scales},
          {"points", cloud.size()},
          {"labels", {{"non_edge", counts[0]}, {"sharp", counts[1]}, {"boundary", counts[2]}}},
@@ -266,6 +276,10 @@ void register_edges_classify(CLI::App& edges) {
   command->add_option("--tile-points", options->tile_points,
                       "LAS input: at most this many points per tile, halo included (default: "
                       "what --memory-limit allows)");
+  command->add_flag("--no-gate", options->no_gate,
+                    "A gated model's first network alone: skip the gate (e.g. for a survey "
+                    "whose density varies so much that the shipped model's sampling gate "
+                    "takes it for mesh vertices; docs/edges.md, \"gate\")");
   command->add_option("--png", options->png, "Also draw the labelled cloud to this PNG")
       ->check(kOutputFile);
   command->add_option("--report", options->report, "Write a JSON report (counts, timings)")

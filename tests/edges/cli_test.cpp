@@ -189,6 +189,10 @@ TEST_F(CliTest, GateJoinsTwoNetworksAndClassifyReportsItsChoice) {
   const auto shipped = nlohmann::json::parse(std::ifstream(path("classify.json")));
   EXPECT_EQ(shipped["gate"]["kind"], "sampling") << shipped.dump();
   EXPECT_EQ(shipped["gate"]["network"], "default") << shipped.dump();
+  run = glint("edges classify " + cloud + " -o " + path("out.ply") + " --model " + three +
+              " --no-gate --report " + path("classify.json"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_TRUE(nlohmann::json::parse(std::ifstream(path("classify.json")))["gate"].is_null());
 }
 
 // --png into a missing folder failed after OUT.ply was written, leaving it behind; now the
