@@ -102,11 +102,12 @@ def main():
                                    if k[0] == "vertices")
 
         scores = {seed: vertex_score(m.stem) for seed, m in candidates.items()}
+        own_score = vertex_score(own.stem)
         best = max(scores, key=lambda s: (round(scores[s], 6), -int(s)))  # ties: lower seed
         winner = candidates[best]
         largest_loss = max(g[own.stem]["groups"][k] - g[winner.stem]["groups"][k]
                            for g in groups for k in g[own.stem]["groups"])
-        ships = scores[best] >= vertex_score(own.stem) + MARGIN and largest_loss <= MAX_LOSS
+        ships = scores[best] >= own_score + MARGIN and largest_loss <= MAX_LOSS
         if ships:  # the veto: default-eval stays above the thesis
             report = run_eval(glint, data / "pointclouds/default-eval", "sharp", [winner],
                               pairs / f"default-eval-{classes}c.json")
@@ -116,10 +117,10 @@ def main():
         if ships:
             shutil.copyfile(winner, models_dir / f"bounded-{classes}c.json")
         decision[f"{classes}c"] = {"vertex_scores": scores,
-                                   "own_vertex_score": vertex_score(own.stem), "seed": int(best),
+                                   "own_vertex_score": own_score, "seed": int(best),
                                    "largest_group_loss": largest_loss, "ships": ships}
         print(f"{classes}c: threshold {threshold}, mesh-vertex seed {best}: vertex score "
-              f"{scores[best]:.4f} vs {vertex_score(own.stem):.4f}, largest group loss "
+              f"{scores[best]:.4f} vs {own_score:.4f}, largest group loss "
               f"{largest_loss:.3f} -> {'ship the pair' if ships else 'keep the single network'}")
     (work / "sampling-gate.json").write_text(json.dumps(decision, indent=2))
 
