@@ -4,6 +4,7 @@
 #include <random>
 
 #include "core/error.h"
+#include "core/hash.h"
 
 namespace glint::cad {
 namespace {
@@ -14,16 +15,9 @@ double uniform(Rng& rng, double low, double high) {
   return std::uniform_real_distribution<double>(low, high)(rng);
 }
 
-std::uint64_t splitmix64(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
-
 // The sampling of cloud `index`, from a stream of its own (independent of the part's draws).
 SampleParams random_sampling(const CadSynthParams& params, std::uint64_t index) {
-  Rng rng(splitmix64(params.part.seed ^ splitmix64(index ^ 0x73616d70ULL)));
+  Rng rng(mix64(params.part.seed ^ mix64(index ^ 0x73616d70ULL)));
   SampleParams s;
   s.sampling = params.samplings[std::uniform_int_distribution<std::size_t>(
       0, params.samplings.size() - 1)(rng)];
@@ -79,7 +73,7 @@ edges::SynthCloud synthesize_cad_cloud(const CadSynthParams& params, std::uint64
   constexpr int kAttempts = 4;
   for (int attempt = 0; attempt < kAttempts; ++attempt) {
     PartParams part_params = params.part;
-    if (attempt > 0) part_params.seed = splitmix64(params.part.seed + attempt);
+    if (attempt > 0) part_params.seed = mix64(params.part.seed + attempt);
     const Part part = random_part(part_params, index);
     try {
       LabelledCloud labelled = sample_shape(part.shape, sampling);

@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "core/error.h"
+#include "core/hash.h"
 #include "edges/feature_index.h"
 #include "geometry/weld.h"
 
@@ -344,13 +345,6 @@ void place(Mesh& mesh, Rng& rng) {
   for (Vec& v : mesh.vertices) v = rotation * ((v - box.center()) * scale);
 }
 
-std::uint64_t splitmix64(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
-
 }  // namespace
 
 const std::vector<std::string>& synth_shape_names() {
@@ -390,7 +384,7 @@ void check_synth_params(const SynthParams& p) {
 
 SynthCloud synthesize_cloud(const SynthParams& params, std::uint64_t index) {
   check_synth_params(params);
-  Rng rng(splitmix64(params.seed ^ splitmix64(index)));
+  Rng rng(mix64(params.seed ^ mix64(index)));
   const auto& all_names = synth_shape_names();
   const SynthShape kind =
       params.shapes.empty()

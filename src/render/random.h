@@ -5,15 +5,9 @@
 #include <cmath>
 #include <cstdint>
 
-namespace glint::render {
+#include "core/hash.h"
 
-// SplitMix64's finaliser: a well-mixed 64-bit hash.
-inline std::uint64_t mix64(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ull;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
+namespace glint::render {
 
 // Keys that keep the streams of different uses of the same pixel independent.
 enum class RandomPurpose : std::uint64_t {
