@@ -3,10 +3,12 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
+#include <functional>
 #include <string>
 
 #include "core/error.h"
 #include "core/timer.h"
+#include "geometry/neighbourhoods.h"
 
 namespace glint::edges {
 namespace {
@@ -36,24 +38,29 @@ std::vector<int> scales_for(const Model& model, const std::vector<int>& scales) 
   return scales.empty() ? model.config.scales : scales;
 }
 
-// Computes the features once and runs every network on each block of them as it is computed,
-// so the rows are never all stored; one result per network. With `gate_values`, also every
-// point's value for the gate of `gate_kind`. Each thread's time is split between the two stages
-// to report them apart.
-std::vector<Classification> run_networks(const PointCloud& cloud,
-                                         const std::vector<const Model*>& networks,
-                                         const std::vector<int>& scales, GateKind gate_kind,
-                                         std::vector<float>* gate_values) {
-  FeatureParams params = networks.front()->config.feature_params();
+// The networks a pass runs, chosen once the cloud's neighbour search is built and before any
+// row (a sampling gate chooses from spacings the search finds).
+using NetworkChoice =
+    std::function<std::vector<const Model*>(const geometry::NeighbourhoodSearch&)>;
+
+// Computes the features once and runs every chosen network on each block of them as it is
+// computed, so the rows are never all stored; one result per network. `model` gives the
+// features and the classes (a gate's networks share them). With `noise_values`, also every
+// point's edges::noise_statistic. Each thread's time is split between the two stages to report
+// them apart.
+std::vector<Classification> run_networks(const PointCloud& cloud, const Model& model,
+                                         const std::vector<int>& scales,
+                                         const NetworkChoice& choose,
+                                         std::vector<float>* noise_values) {
+  FeatureParams params = model.config.feature_params();
   params.scales = scales;
   const int scale_count = static_cast<int>(scales.size());
   const int per_scale = params.per_scale();
   const std::size_t row_size = params.row_size();
-  const std::size_t classes = static_cast<std::size_t>(networks.front()->config.classes);
+  const std::size_t classes = static_cast<std::size_t>(model.config.classes);
+  std::vector<const Model*> networks;
   std::vector<Classification> results;
-  for (std::size_t n = 0; n < networks.size(); ++n) results.push_back(sized_result(cloud.size()));
-  const bool noise_values = gate_values && gate_kind == GateKind::noise;
-  if (noise_values) gate_values->resize(cloud.size());
+  if (noise_values) noise_values->resize(cloud.size());
 
   struct Worker {
     Model::PredictScratch scratch;
@@ -85,11 +92,15 @@ std::vector<Classification> run_networks(const PointCloud& cloud,
         }
         if (noise_values)
           for (std::size_t b = 0; b < count; ++b)
-            (*gate_values)[points[b]] =
+            (*noise_values)[points[b]] =
                 noise_statistic(rows + b * row_size, scale_count, per_scale);
         worker.network_s += network_watch.elapsed_s();
       },
-      gate_values && gate_kind == GateKind::sampling ? gate_values : nullptr);
+      [&](const geometry::NeighbourhoodSearch& search) {
+        networks = choose(search);
+        for (std::size_t n = 0; n < networks.size(); ++n)
+          results.push_back(sized_result(cloud.size()));
+      });
   const double total_s = watch.elapsed_s();
   double network_s = 0;
   for (const Worker& worker : workers) network_s += worker.network_s;
@@ -99,6 +110,23 @@ std::vector<Classification> run_networks(const PointCloud& cloud,
     result.features_s = total_s - result.inference_s;
   }
   return results;
+}
+
+// The same networks whatever the cloud.
+NetworkChoice fixed(std::vector<const Model*> networks) {
+  return [networks](const geometry::NeighbourhoodSearch&) { return networks; };
+}
+
+// The tally of a sampling gate over the points `reads` marks, their spacings found by `search`
+// (built for the largest scale: the spacing is the one FeatureMatrix::squared_spacings holds).
+GateTally spacing_tally(const Model& model, const geometry::NeighbourhoodSearch& search,
+                        std::span<const std::uint8_t> reads, int largest_scale) {
+  const int k = std::min(kAreaSpacingNeighbour + 1, largest_scale);
+  const std::vector<float> spacings = search.kth_nearest_squared_distances(k, {}, reads);
+  GateTally tally = model.new_tally();
+  for (std::size_t i = 0; i < reads.size(); ++i)
+    if (reads[i]) tally.add(spacings[i]);
+  return tally;
 }
 
 // The gate's tally of every point's value.
@@ -114,32 +142,74 @@ void keep_gate_choice(Classification& result, const GateTally& tally) {
   result.gate_network_answered = tally.gate_network_answers();
 }
 
+// The points of a whole cloud that a sampling gate reads.
+std::vector<std::uint8_t> whole_cloud_reads(std::size_t points) {
+  std::vector<std::uint8_t> reads(points);
+  for (std::size_t i = 0; i < points; ++i) reads[i] = sampling_gate_reads(i, points) ? 1 : 0;
+  return reads;
+}
+
 }  // namespace
 
 GatedClassification classify_gated(const PointCloud& cloud, const Model& model,
                                    const std::vector<int>& scales) {
-  if (!model.gated()) throw Error("model", "gate", "the model has no gate");
+  if (!model.gated() || model.gate_kind != GateKind::noise)
+    throw Error("model", "gate", "both answers are kept for a noise gate only");
   model.check();
   GatedClassification result;
   std::vector<Classification> both =
-      run_networks(cloud, {&model, model.gate_network.get()}, scales_for(model, scales),
-                   model.gate_kind, &result.gate_values);
+      run_networks(cloud, model, scales_for(model, scales),
+                   fixed({&model, model.gate_network.get()}), &result.gate_values);
   result.model_network = std::move(both[0]);
   result.gate_network = std::move(both[1]);
   return result;
 }
 
+GateTally sampling_gate_tally(const PointCloud& cloud, const Model& model,
+                              std::span<const std::uint8_t> reads, const std::vector<int>& scales) {
+  if (!model.gated() || model.gate_kind != GateKind::sampling)
+    throw Error("model", "gate", "the model has no sampling gate");
+  const int largest_scale = scales_for(model, scales).front();
+  // Cells sized as for the features: a grid sized for the small k sends the queries of sparse
+  // parts to a k-d tree built for them alone.
+  geometry::NeighbourhoodParams params;
+  params.k = largest_scale;
+  return spacing_tally(model, geometry::NeighbourhoodSearch(cloud, params), reads, largest_scale);
+}
+
+Classification classify_with_network(const PointCloud& cloud, const Model& model, bool gate_network,
+                                     const std::vector<int>& scales) {
+  model.check();
+  if (gate_network && !model.gated()) throw Error("model", "gate", "the model has no gate");
+  const Model* network = gate_network ? model.gate_network.get() : &model;
+  return std::move(
+      run_networks(cloud, model, scales_for(model, scales), fixed({network}), nullptr)[0]);
+}
+
 Classification classify(const PointCloud& cloud, const Model& model,
                         const std::vector<int>& scales) {
-  if (!model.gated()) {
-    model.check();
-    return std::move(
-        run_networks(cloud, {&model}, scales_for(model, scales), model.gate_kind, nullptr)[0]);
+  if (!model.gated()) return classify_with_network(cloud, model, false, scales);
+  if (model.gate_kind == GateKind::noise) {
+    GatedClassification both = classify_gated(cloud, model, scales);
+    const GateTally tally = tally_of(model, both.gate_values);
+    Classification result =
+        std::move(tally.gate_network_answers() ? both.gate_network : both.model_network);
+    keep_gate_choice(result, tally);
+    return result;
   }
-  GatedClassification both = classify_gated(cloud, model, scales);
-  const GateTally tally = tally_of(model, both.gate_values);
-  Classification result =
-      std::move(tally.gate_network_answers() ? both.gate_network : both.model_network);
+  // A sampling gate chooses from the spacings before the features: one network runs.
+  model.check();
+  const std::vector<int> chosen_scales = scales_for(model, scales);
+  const std::vector<std::uint8_t> reads = whole_cloud_reads(cloud.size());
+  GateTally tally = model.new_tally();
+  Classification result = std::move(run_networks(
+      cloud, model, chosen_scales,
+      [&](const geometry::NeighbourhoodSearch& search) {
+        tally = spacing_tally(model, search, reads, chosen_scales.front());
+        return std::vector<const Model*>{tally.gate_network_answers() ? model.gate_network.get()
+                                                                      : &model};
+      },
+      nullptr)[0]);
   keep_gate_choice(result, tally);
   return result;
 }
@@ -157,7 +227,8 @@ Classification classify_features(const FeatureMatrix& features, const Model& mod
       if (features.squared_spacings.size() != features.points)
         throw Error("features", "squared_spacings",
                     "a sampling gate needs every point's spacing (compute_features)");
-      for (const float value : features.squared_spacings) tally.add(value);
+      for (std::size_t i = 0; i < features.points; ++i)
+        if (sampling_gate_reads(i, features.points)) tally.add(features.squared_spacings[i]);
     }
     keep_gate_choice(result, tally);
     if (result.gate_network_answered) network = model.gate_network.get();

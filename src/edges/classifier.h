@@ -1,6 +1,7 @@
 #pragma once
 // The whole BoundED pass over a cloud: features at the model's scales, then the network.
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/point_cloud.h"
@@ -25,21 +26,37 @@ struct Classification {
 
 // Classifies every point. `scales` overrides the model's neighbourhood sizes (same count;
 // e.g. for a much denser or sparser cloud than the training data); empty = the model's.
-// A gated model runs both of its networks on the features and keeps one for the whole cloud.
+// A gated model keeps one network for the whole cloud: a sampling gate chooses it from the
+// spacings of the points sampling_gate_reads picks, before the features, and only it runs; a
+// noise gate reads the features, so both networks run on them and one answer is kept.
 Classification classify(const PointCloud& cloud, const Model& model,
                         const std::vector<int>& scales = {});
 // The network part alone, on features computed at the model's scale count (several models
 // with the same scales can share one feature matrix); features_s stays 0.
 Classification classify_features(const FeatureMatrix& features, const Model& model);
 
-// Both answers of a gated model for every point, the choice left open (tiled classification
-// makes it once for the whole file, from every tile's core points).
+// One network of a model, the gate not asked: the gate's network or the model's own (tiled
+// classification asks the gate once for the whole file). Throws glint::Error when
+// `gate_network` is set for a model without a gate, and as classify().
+Classification classify_with_network(const PointCloud& cloud, const Model& model, bool gate_network,
+                                     const std::vector<int>& scales = {});
+
+// A sampling gate's tally of the points of `cloud` that `reads` marks (one entry per point),
+// their spacings as classify() finds them (tiled classification sums the tallies of every
+// tile's core points before it classifies a tile). Throws glint::Error for a model without a
+// sampling gate and when `cloud` has fewer points than the largest scale.
+GateTally sampling_gate_tally(const PointCloud& cloud, const Model& model,
+                              std::span<const std::uint8_t> reads,
+                              const std::vector<int>& scales = {});
+
+// Both answers of a noise-gated model for every point, the choice left open (tiled
+// classification makes it once for the whole file, from every tile's core points).
 struct GatedClassification {
   Classification model_network;    // the model's own network
   Classification gate_network;     // the gate's network
-  std::vector<float> gate_values;  // each point's value for GateTally::add
+  std::vector<float> gate_values;  // each point's noise statistic, for GateTally::add
 };
-// Throws glint::Error for a model without a gate, and as classify().
+// Throws glint::Error for a model without a noise gate, and as classify().
 GatedClassification classify_gated(const PointCloud& cloud, const Model& model,
                                    const std::vector<int>& scales = {});
 

@@ -416,15 +416,17 @@ std::vector<float> squared_spacings(const PointCloud& cloud,
 // Every point's features, written to row_for(point, scratch); row_written(scratch) follows
 // on the same thread. With `spacings_out` (one entry per point), also each point's squared
 // distance to its kAreaSpacingNeighbour-th nearest other point, read off its sorted
-// neighbourhood. The cloud must have passed check_cloud.
+// neighbourhood. search_ready as in compute_features_in_blocks. The cloud must have passed
+// check_cloud.
 template <class RowFor, class RowWritten>
 void compute_rows(const PointCloud& cloud, const FeatureParams& params,
                   tbb::enumerable_thread_specific<Scratch>& scratches, RowFor&& row_for,
-                  RowWritten&& row_written, float* spacings_out) {
+                  RowWritten&& row_written, float* spacings_out, const SearchReady& search_ready) {
   const PointKernel kernel = point_kernel();
   geometry::NeighbourhoodParams search_params;
   search_params.k = params.scales[0];
   const geometry::NeighbourhoodSearch search(cloud, search_params);
+  if (search_ready) search_ready(search);
   // Handed out per neighbour with the positions, where the kernel weighs by them.
   const std::vector<float> spacings =
       params.area_weights ? squared_spacings(cloud, search) : std::vector<float>();
@@ -459,16 +461,15 @@ FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& par
   tbb::enumerable_thread_specific<Scratch> scratches;
   compute_rows(
       cloud, params, scratches, [&](std::uint32_t point, Scratch&) { return features.row(point); },
-      [](Scratch&) {}, features.squared_spacings.data());
+      [](Scratch&) {}, features.squared_spacings.data(), {});
   return features;
 }
 
 void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& params,
                                 std::size_t block_size, const FeatureBlockConsumer& consume,
-                                std::vector<float>* squared_spacings) {
+                                const SearchReady& search_ready) {
   check_cloud(cloud, params);
   if (block_size == 0) throw Error("", "block size", "must be at least 1");
-  if (squared_spacings) squared_spacings->resize(cloud.size());
   const std::size_t row_size = params.row_size();
   tbb::enumerable_thread_specific<Scratch> scratches([&] {
     Scratch scratch;
@@ -487,7 +488,7 @@ void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& pa
         consume(scratch.block_points.data(), scratch.block_rows.data(), block_size);
         scratch.block_points.clear();
       },
-      squared_spacings ? squared_spacings->data() : nullptr);
+      nullptr, search_ready);
   // Each thread's last, partial block.
   for (Scratch& scratch : scratches) {
     if (scratch.block_points.empty()) continue;

@@ -38,6 +38,10 @@
 
 #include "core/point_cloud.h"
 
+namespace glint::geometry {
+class NeighbourhoodSearch;
+}
+
 namespace glint::edges {
 
 inline constexpr int kThesisFeaturesPerScale = 12;
@@ -91,13 +95,16 @@ FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& par
 // The same features handed over in blocks as they are computed, never all stored (a 1M-point
 // cloud's rows are 192 MB): consume(points, rows, count) gets up to block_size point indices
 // and their rows (row-major, scales·per_scale floats each), from several threads at once; every
-// point comes in exactly one block. Same checks and errors as compute_features. With
-// `squared_spacings`, also every point's FeatureMatrix::squared_spacings value.
+// point comes in exactly one block. Same checks and errors as compute_features.
+// search_ready(search), when given, is called once before the first row with the cloud's
+// neighbour search (its largest k is the largest scale): a choice that depends on the whole
+// cloud, such as a sampling gate's, is made there, before any row is handed to `consume`.
 using FeatureBlockConsumer =
     std::function<void(const std::uint32_t* points, const float* rows, std::size_t count)>;
+using SearchReady = std::function<void(const geometry::NeighbourhoodSearch& search)>;
 void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& params,
                                 std::size_t block_size, const FeatureBlockConsumer& consume,
-                                std::vector<float>* squared_spacings = nullptr);
+                                const SearchReady& search_ready = {});
 
 // The noise statistic of one point, from its feature row (`scales` scales of `per_scale`
 // values each): at the smallest scale, sqrt(sigma_upper(3) + sigma_lower(3)), the spread of

@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 
 #include "core/error.h"
+#include "core/hash.h"
 #include "core/parallel.h"
 #include "io/json_fields.h"
 #include "io/json_report.h"
@@ -192,6 +194,12 @@ void GateTally::add(float value) {
   ++counts_[2 + static_cast<std::size_t>(bin >= 0.0 ? std::min(bin, last) : 0.0)];
 }
 
+void GateTally::merge(const GateTally& other) {
+  if (other.kind_ != kind_ || other.counts_.size() != counts_.size())
+    throw Error("gate", "tally", "tallies of different gates cannot be merged");
+  for (std::size_t i = 0; i < counts_.size(); ++i) counts_[i] += other.counts_[i];
+}
+
 double GateTally::statistic() const {
   const std::uint64_t n = points();
   if (n == 0) return 0;
@@ -211,6 +219,11 @@ double GateTally::statistic() const {
 bool GateTally::gate_network_answers() const {
   if (kind_ == GateKind::noise) return 2 * counts_[1] > points();
   return points() > 0 && statistic() >= threshold_;
+}
+
+bool sampling_gate_reads(std::uint64_t index, std::uint64_t points) {
+  if (points <= kSamplingGatePoints) return true;
+  return mix64(index) < std::numeric_limits<std::uint64_t>::max() / points * kSamplingGatePoints;
 }
 
 namespace {

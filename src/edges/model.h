@@ -85,6 +85,8 @@ class GateTally {
   GateTally(GateKind kind, float threshold);
   // One point's value: its noise statistic or its squared spacing (FeatureMatrix).
   void add(float value);
+  // Adds another tally of the same gate (a tile's).
+  void merge(const GateTally& other);
   // The counts to sum across ranks: points, quiet points, spacing bins.
   std::vector<std::uint64_t>& counts() { return counts_; }
   std::uint64_t points() const { return counts_[0]; }
@@ -98,6 +100,14 @@ class GateTally {
   float threshold_;
   std::vector<std::uint64_t> counts_;
 };
+
+// The points a sampling gate reads: every point of a cloud of up to kSamplingGatePoints, and
+// about that many of a larger one, picked by a hash of the input index. Their spacings are
+// searched before the features, so the gate chooses first and one network runs; a tiled file
+// picks the same points as the whole cloud, and a sample this large puts ln(P90 / P10) within
+// about a bin of the whole cloud's.
+inline constexpr std::uint64_t kSamplingGatePoints = std::uint64_t(1) << 17;
+bool sampling_gate_reads(std::uint64_t index, std::uint64_t points);
 
 class Model {
  public:

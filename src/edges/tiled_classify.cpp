@@ -41,8 +41,10 @@ void put_result(const Classification& result, std::size_t i, std::uint8_t* recor
 // A tile's point as stored in its bucket file.
 struct TilePoint {
   float x, y, z;
-  std::uint32_t core;  // 1 = the tile's own point, 0 = halo
+  std::uint32_t flags;  // kCore | kGateReads
 };
+constexpr std::uint32_t kCore = 1;       // the tile's own point (else a halo point)
+constexpr std::uint32_t kGateReads = 2;  // a core point whose spacing a sampling gate reads
 
 // The rows [begin, end) of the input that rank `rank` of `ranks` streams in every pass.
 std::pair<std::uint64_t, std::uint64_t> slice_of(std::uint64_t points, int rank, int ranks) {
@@ -371,6 +373,7 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
   std::uint64_t tile_limit = (limit - kFixedBytes) / kTileBytesPerPoint;
   if (params.tile_points > 0) tile_limit = std::min(tile_limit, params.tile_points);
 
+  const bool sampling_gate = model.gated() && model.gate_kind == GateKind::sampling;
   TiledClassifyStats stats;
   stats.points = n;
   stats.points_per_tile_limit = tile_limit;
@@ -530,10 +533,11 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
     std::vector<File> buckets(tile_count);
     stream_records(
         reader, slice_begin, slice_end, buffer,
-        [&](std::uint64_t, std::size_t count, const std::uint8_t* records) {
+        [&](std::uint64_t first, std::size_t count, const std::uint8_t* records) {
           for (std::size_t j = 0; j < count; ++j) {
             std::int32_t xyz[3];
             io::las_record_xyz(records + j * in_length, xyz);
+            const bool gate_reads = sampling_gate && sampling_gate_reads(first + j, n);
             const std::int64_t ux = std::int64_t(xyz[0]) - grid.low[0];
             const std::int64_t uy = std::int64_t(xyz[1]) - grid.low[1];
             const std::size_t own = core_tile(xyz);
@@ -562,7 +566,7 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
                   buckets[t].reset(open_file(bucket_path(t, rank), "wb", file_buffers[t]));
                 }
                 TilePoint stored = point;
-                stored.core = t == own ? 1 : 0;
+                stored.flags = t == own ? kCore | (gate_reads ? kGateReads : 0) : 0;
                 write_all(buckets[t].get(), &stored, sizeof stored, bucket_path(t, rank));
                 if (t == own) ++tile_counts[t * std::size_t(ranks) + std::size_t(rank)];
                 ++tile_counts[tile_count * std::size_t(ranks) + t];
@@ -609,47 +613,77 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
       n, stats.tiles, stats.tile_side_m, stats.halo_m_max,
       100.0 * double(stats.halo_points) / double(n), mine.size());
 
-  // Per tile: classify core and halo together, keep the core's results in input order.
-  watch.restart();
-  const std::size_t record_bytes = model.gated() ? 2 * kResultBytes : kResultBytes;
+  std::vector<char> file_buffer(1 << 20);
+  // A tile's core and halo points from every rank's bucket, with their flags.
+  auto load_tile = [&](std::size_t t, PointCloud& cloud, std::vector<std::uint8_t>& flags) {
+    cloud = PointCloud();
+    cloud.reserve(tile_total[t]);
+    flags.clear();
+    flags.reserve(tile_total[t]);
+    for (int r = 0; r < ranks; ++r) {
+      const std::filesystem::path path = bucket_path(t, r);
+      if (!std::filesystem::exists(path)) continue;
+      File file(open_file(path, "rb", file_buffer));
+      TilePoint point;
+      while (std::fread(&point, sizeof point, 1, file.get()) == 1) {
+        cloud.push_back(point.x, point.y, point.z);
+        flags.push_back(static_cast<std::uint8_t>(point.flags));
+      }
+    }
+    if (cloud.size() != tile_total[t]) {
+      throw Error(
+          bucket_path(t, 0).string(), "",
+          fmt::format("tile {} holds {} points, {} were written", t, cloud.size(), tile_total[t]));
+    }
+  };
   std::uint64_t rank_points = 0;
   for (const std::size_t t : mine) rank_points += tile_core[t];
-  GateTally tally = model.new_tally();
   stats.rank_points = rank_points;
   stats.rank_tiles = mine.size();
+  PointCloud cloud;
+  std::vector<std::uint8_t> flags;
+  const bool was_quiet = is_quiet();
+
+  // A sampling gate chooses the file's network before any tile is classified, from the spacings
+  // of the core points it reads (the same points as in the whole cloud).
+  watch.restart();
+  GateTally tally = model.new_tally();
+  if (sampling_gate) {
+    ProgressBar progress("gate", rank_points);
+    for (const std::size_t t : mine) {
+      load_tile(t, cloud, flags);
+      std::vector<std::uint8_t> reads(flags.size());
+      for (std::size_t i = 0; i < flags.size(); ++i) reads[i] = (flags[i] & kGateReads) ? 1 : 0;
+      try {
+        tally.merge(sampling_gate_tally(cloud, model, reads, scales));
+      } catch (const Error& e) {
+        throw Error(input, e.element(), fmt::format("tile {}: {}", t, e.reason()));
+      }
+      progress.advance(tile_core[t]);
+    }
+    progress.finish();
+    world.sum(tally.counts());
+    stats.gate_statistic = tally.statistic();
+    stats.gate_network_answered = tally.gate_network_answers();
+  }
+
+  // Per tile: classify core and halo together, keep the core's results in input order. A noise
+  // gate reads the features, so a noise-gated model's tile keeps both networks' results and
+  // the file's choice comes after the last tile.
+  const bool both_answers = model.gated() && !sampling_gate;
+  const std::size_t record_bytes = both_answers ? 2 * kResultBytes : kResultBytes;
   {
     ProgressBar progress("classify", rank_points);
-    const bool was_quiet = is_quiet();
-    std::vector<char> file_buffer(1 << 20);
     for (const std::size_t t : mine) {
-      PointCloud cloud;
-      cloud.reserve(tile_total[t]);
-      std::vector<std::uint8_t> core;
-      core.reserve(tile_total[t]);
-      for (int r = 0; r < ranks; ++r) {
-        const std::filesystem::path path = bucket_path(t, r);
-        if (!std::filesystem::exists(path)) continue;
-        File file(open_file(path, "rb", file_buffer));
-        TilePoint point;
-        while (std::fread(&point, sizeof point, 1, file.get()) == 1) {
-          cloud.push_back(point.x, point.y, point.z);
-          core.push_back(static_cast<std::uint8_t>(point.core));
-        }
-      }
-      if (cloud.size() != tile_total[t]) {
-        throw Error(bucket_path(t, 0).string(), "",
-                    fmt::format("tile {} holds {} points, {} were written", t, cloud.size(),
-                                tile_total[t]));
-      }
+      load_tile(t, cloud, flags);
       set_quiet(true);  // one bar over all tiles, not one per tile
-      // A gated model's tile keeps both networks' results; the file's choice comes after the
-      // last tile.
       GatedClassification result;
       try {
-        if (model.gated()) {
+        if (both_answers) {
           result = classify_gated(cloud, model, scales);
         } else {
-          result.model_network = classify(cloud, model, scales);
+          result.model_network =
+              classify_with_network(cloud, model, stats.gate_network_answered, scales);
         }
       } catch (const Error& e) {
         set_quiet(was_quiet);
@@ -659,10 +693,10 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
       const std::filesystem::path result_path = folder.path / fmt::format("t{}.res", t);
       File results(open_file(result_path, "wb", file_buffer));
       for (std::size_t i = 0; i < cloud.size(); ++i) {
-        if (!core[i]) continue;
+        if (!(flags[i] & kCore)) continue;
         std::uint8_t record[2 * kResultBytes];
         put_result(result.model_network, i, record);
-        if (model.gated()) {
+        if (both_answers) {
           put_result(result.gate_network, i, record + kResultBytes);
           tally.add(result.gate_values[i]);
         }
@@ -677,13 +711,14 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
     }
     progress.finish();
   }
+  cloud = PointCloud();
   stats.classify_s = watch.elapsed_s();
-  if (model.gated()) {  // one choice of network for the whole file
+  if (both_answers) {  // one choice of network for the whole file
     world.sum(tally.counts());
     stats.gate_statistic = tally.statistic();
     stats.gate_network_answered = tally.gate_network_answers();
   }
-  const std::size_t result_offset = stats.gate_network_answered ? kResultBytes : 0;
+  const std::size_t result_offset = both_answers && stats.gate_network_answered ? kResultBytes : 0;
   world.barrier();
 
   // Pass 4: the output, in input order; each point takes the next result of its core tile.

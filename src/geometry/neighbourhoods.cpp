@@ -704,7 +704,8 @@ KthKernel kth_kernel() {
 }  // namespace
 
 std::vector<float> NeighbourhoodSearch::kth_nearest_squared_distances(
-    int k, const std::function<void(std::size_t)>& progress) const {
+    int k, const std::function<void(std::size_t)>& progress,
+    std::span<const std::uint8_t> wanted) const {
   const PointCloud& cloud = state_->cloud;
   const Grid& grid = state_->grid;
   if (k < 1 || k > kMaxSmallK) {
@@ -716,9 +717,17 @@ std::vector<float> NeighbourhoodSearch::kth_nearest_squared_distances(
                 "the cloud has " + std::to_string(cloud.size()) +
                     " points, fewer than k = " + std::to_string(k));
   }
+  if (!wanted.empty() && wanted.size() != cloud.size()) {
+    throw Error("", "k-th neighbour distances",
+                "the mask of wanted points has " + std::to_string(wanted.size()) + " entries for " +
+                    std::to_string(cloud.size()) + " points");
+  }
+  const auto is_wanted = [&](std::uint32_t slot) {
+    return wanted.empty() || wanted[grid.original[slot]] != 0;
+  };
   const std::size_t cells = grid.cell_begin.size() - 1;
   const KthKernel kth_candidate_distance = kth_kernel();
-  std::vector<float> result(cloud.size());
+  std::vector<float> result(cloud.size(), 0.0f);
   tbb::enumerable_thread_specific<Scratch> scratches;
   parallel_for_chunks(cells, 16, [&](std::size_t first_cell, std::size_t end_cell) {
     Scratch& scratch = scratches.local();
@@ -726,9 +735,14 @@ std::vector<float> NeighbourhoodSearch::kth_nearest_squared_distances(
     for (std::size_t cell_id = first_cell; cell_id < end_cell; ++cell_id) {
       const std::uint32_t begin = grid.cell_begin[cell_id], end = grid.cell_begin[cell_id + 1];
       scratch.retry.clear();
+      bool any_wanted = false;
+      for (std::uint32_t slot = begin; slot < end && !any_wanted; ++slot)
+        any_wanted = is_wanted(slot);
+      if (!any_wanted) continue;
       // The cells are sized for the larger k, so one cell around usually holds the k nearest.
       gather_block(grid, cell_id, 1, scratch, lower, upper);
       for (std::uint32_t slot = begin; slot < end; ++slot) {
+        if (!is_wanted(slot)) continue;
         const float qx = grid.xs[slot], qy = grid.ys[slot], qz = grid.zs[slot];
         const float kth = kth_candidate_distance(qx, qy, qz, k, scratch);
         const double guaranteed = guaranteed_radius(qx, qy, qz, lower, upper);

@@ -75,9 +75,12 @@ class NeighbourhoodSearch {
   // cell around a query's cell and a running list of the k smallest replace the sorted lists.
   // Computed as (x_j - x_q)² + (y_j - y_q)² + (z_j - z_q)² in float without fused multiply-adds,
   // as a visitor of for_each computes it from dx, dy, dz. Throws glint::Error when k is outside
-  // [1, kMaxSmallK] or the cloud has fewer than k points.
+  // [1, kMaxSmallK] or the cloud has fewer than k points, or when `wanted` is given with another
+  // size than the cloud's. With `wanted`, only the points with a non-zero entry are queried (a
+  // sample costs what it holds, not the cloud); the other entries are 0.
   std::vector<float> kth_nearest_squared_distances(
-      int k, const std::function<void(std::size_t)>& progress = {}) const;
+      int k, const std::function<void(std::size_t)>& progress = {},
+      std::span<const std::uint8_t> wanted = {}) const;
 
  private:
   struct State;

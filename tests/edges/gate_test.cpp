@@ -104,6 +104,9 @@ TEST(NoiseGate, BothAnswersAreKeptWhenTheChoiceIsLeftOpen) {
   EXPECT_EQ(both.model_network.labels, std::vector<std::uint8_t>(cloud.size(), 2));
   EXPECT_EQ(both.gate_network.labels, std::vector<std::uint8_t>(cloud.size(), 1));
   EXPECT_THROW(classify_gated(cloud, constant_model(2)), Error);
+  EXPECT_THROW(classify_gated(
+                   cloud, constant_model(2).with_gate(GateKind::sampling, constant_model(1), 1.f)),
+               Error);
 }
 
 // A noise tally of `quiet` values below the threshold 0.1 and `loud` above it.
@@ -179,6 +182,45 @@ TEST(SamplingGate, ChoosesTheMeshVertexNetworkOnlyForUnevenSpacing) {
   FeatureMatrix without_spacings = compute_features(uneven);
   without_spacings.squared_spacings.clear();
   EXPECT_THROW(classify_features(without_spacings, gated), Error);
+}
+
+TEST(SamplingGate, ReadsEveryPointOfASmallCloudAndAboutAFixedNumberOfALargeOne) {
+  for (std::uint64_t i = 0; i < kSamplingGatePoints; ++i)
+    ASSERT_TRUE(sampling_gate_reads(i, kSamplingGatePoints));
+  for (const std::uint64_t points : {kSamplingGatePoints + 1, 8 * kSamplingGatePoints}) {
+    std::uint64_t read = 0;
+    for (std::uint64_t i = 0; i < points; ++i) read += sampling_gate_reads(i, points);
+    // A binomial count: its standard deviation is below 400.
+    EXPECT_NEAR(double(read), double(kSamplingGatePoints), 2000.0) << points << " points";
+  }
+}
+
+TEST(SamplingGate, ALargeCloudsSampleSpreadsAsTheWholeCloud) {
+  // 160k grid points of unit spacing and 120k in dense rows: the sample's ln(P90 / P10) within
+  // two bins of every point's, and the same choice.
+  PointCloud cloud;
+  for (int y = 0; y < 400; ++y)
+    for (int x = 0; x < 400; ++x) cloud.push_back(float(x), float(y), 0.0f);
+  for (int row = 0; row < 3; ++row)
+    for (int i = 0; i < 40000; ++i)
+      cloud.push_back(0.01f * float(i), 200.4f + 0.1f * float(row), 0.0f);
+  ASSERT_GT(cloud.size(), kSamplingGatePoints);
+  const Model gated = constant_model(1).with_gate(GateKind::sampling, constant_model(0), 0.98f);
+  std::vector<std::uint8_t> every(cloud.size(), 1), sample(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    sample[i] = sampling_gate_reads(i, cloud.size()) ? 1 : 0;
+  const GateTally whole = sampling_gate_tally(cloud, gated, every);
+  const GateTally sampled = sampling_gate_tally(cloud, gated, sample);
+  EXPECT_EQ(whole.points(), cloud.size());
+  EXPECT_LT(sampled.points(), cloud.size());
+  EXPECT_NEAR(sampled.statistic(), whole.statistic(), 2.0 / GateTally::kBinsPerUnit);
+  EXPECT_EQ(sampled.gate_network_answers(), whole.gate_network_answers());
+  EXPECT_THROW(sampling_gate_tally(cloud, constant_model(1), every), Error);
+
+  GateTally merged = gated.new_tally();
+  merged.merge(sampled);
+  EXPECT_EQ(merged.counts(), GateTally(sampled).counts());
+  EXPECT_THROW(merged.merge(GateTally(GateKind::noise, 0.1f)), Error);
 }
 
 class GateFile : public ::testing::Test {

@@ -157,6 +157,26 @@ TEST(Neighbourhoods, KthDistancesAreTheExactKthSmallest) {
   }
 }
 
+TEST(Neighbourhoods, KthDistancesOfWantedPointsOnly) {
+  // Every third point wanted: their entries as in the full pass (retries and the k-d tree
+  // included), the others 0; a mask of another size is refused.
+  const PointCloud cloud = uneven_cloud();
+  NeighbourhoodParams params;
+  params.k = 64;
+  const NeighbourhoodSearch search(cloud, params);
+  const std::vector<float> all = search.kth_nearest_squared_distances(9);
+  std::vector<std::uint8_t> wanted(cloud.size(), 0);
+  for (std::size_t i = 0; i < cloud.size(); i += 3) wanted[i] = 1;
+  const std::vector<float> some = search.kth_nearest_squared_distances(9, {}, wanted);
+  ASSERT_EQ(some.size(), cloud.size());
+  std::size_t different = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    different += some[i] != (wanted[i] ? all[i] : 0.0f);
+  EXPECT_EQ(different, 0u);
+  wanted.pop_back();
+  EXPECT_THROW(search.kth_nearest_squared_distances(9, {}, wanted), glint::Error);
+}
+
 TEST(Neighbourhoods, KthDistancesRefuseBadK) {
   PointCloud cloud;
   for (int i = 0; i < 20; ++i) cloud.push_back(float(i), 0.f, 0.f);
