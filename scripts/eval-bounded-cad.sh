@@ -11,7 +11,7 @@
 # the baselines `glint edges eval` prints (CA, and the angle-gap boundary criterion where the
 # build has it).
 # Held-out set: 20 parts of seed 9001, or of $SEED in another WORK (training used seeds 101 and
-# 102, model selection seeds 5001, 5002 and 5301; the recipe `cylinder` was never trained on),
+# 102, model selection seeds 5001, 5002, 5301 and 5401; the recipe `cylinder` was never trained on),
 # each sampled at its mesh vertices and uniformly,
 # clean and with noise 0.25, 0.5 and 1 median spacing along the normal: sharp edges scored on
 # the closed parts, boundaries on the same parts cut open by a random plane. The angle-gap
