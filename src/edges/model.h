@@ -105,7 +105,7 @@ class GateTally {
 // about that many of a larger one, picked by a hash of the input index. Their spacings are
 // searched before the features, so the gate chooses first and one network runs; a tiled file
 // picks the same points as the whole cloud. A sample this large puts ln(P90 / P10) within a bin
-// or two of the whole cloud's (the same bins on a 1.62M-point survey).
+// or two of the whole cloud's.
 inline constexpr std::uint64_t kSamplingGatePoints = std::uint64_t(1) << 17;
 bool sampling_gate_reads(std::uint64_t index, std::uint64_t points);
 
