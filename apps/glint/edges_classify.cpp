@@ -63,23 +63,29 @@ bool is_las(const std::string& path) {
   return extension == ".las" || extension == ".laz";
 }
 
-// What the gate of a gated model chose, for the log and the report (null otherwise).
-nlohmann::json gate_entry(const edges::Model& model, double statistic, bool gate_network_answered) {
-  if (!model.gated()) return nullptr;
-  const char* network = model.network_name(gate_network_answered);
-  if (model.gate_kind == edges::GateKind::noise) {
-    log().info("noise gate: {:.1f} % of the points below {} -> the {} network answers",
-               100.0 * statistic, model.gate_threshold, network);
-  } else {
-    log().info(
-        "sampling gate: spacing spread ln(P90/P10) {:.3f} against {} -> the {} network "
-        "answers",
-        statistic, model.gate_threshold, network);
+// What the gates of a gated model chose, for the log and the report (null otherwise): the first
+// gate's entry, holding the next gate's under "gate" where the first passed the cloud on.
+nlohmann::json gate_entry(const std::vector<edges::GateDecision>& decisions) {
+  for (const edges::GateDecision& decision : decisions) {
+    const std::string network = edges::network_name({decision});
+    if (decision.kind == edges::GateKind::noise) {
+      log().info("noise gate: {:.1f} % of the points read below {} -> the {} network",
+                 100.0 * decision.statistic, decision.threshold, network);
+    } else {
+      log().info("sampling gate: spacing spread ln(P90/P10) {:.3f} against {} -> the {} network",
+                 decision.statistic, decision.threshold, network);
+    }
   }
-  return {{"kind", model.gate_kind == edges::GateKind::noise ? "noise" : "sampling"},
-          {"threshold", model.gate_threshold},
-          {"statistic", statistic},
-          {"network", network}};
+  nlohmann::json entry = nullptr;
+  for (auto decision = decisions.rbegin(); decision != decisions.rend(); ++decision) {
+    nlohmann::json inner = std::move(entry);
+    entry = {{"kind", decision->kind == edges::GateKind::noise ? "noise" : "sampling"},
+             {"threshold", decision->threshold},
+             {"statistic", decision->statistic},
+             {"network", edges::network_name({*decision})}};
+    if (!inner.is_null()) entry["gate"] = std::move(inner);
+  }
+  return entry;
 }
 
 // LAS in, LAS out: streamed, tiled when the cloud exceeds the memory limit, spread over the
@@ -118,7 +124,7 @@ void run_classify_las(const ClassifyOptions& options) {
                  e.what());
     world.abort(1);
   }
-  const nlohmann::json gate = gate_entry(model, stats.gate_statistic, stats.gate_network_answered);
+  const nlohmann::json gate = gate_entry(stats.gates);
   if (world.size() > 1) {
     fmt::print(
         "rank {}/{}: {} tiles, {} points classified in {:.2f} s (read {:.2f} s, write "
@@ -186,9 +192,7 @@ void run_classify(const ClassifyOptions& options) {
     throw Error(options.input, e.element(), e.reason());
   }
   const nlohmann::json gate =
-      options.method == "angle-gap"
-          ? nlohmann::json(nullptr)
-          : gate_entry(model, result.gate_statistic, result.gate_network_answered);
+      options.method == "angle-gap" ? nlohmann::json(nullptr) : gate_entry(result.gates);
   edges::attach_classification(cloud, result);
   // The picture is made before any file is written, and a failure writing it takes the PLY
   // back: the command leaves both outputs or neither.

@@ -112,10 +112,16 @@ void run_eval(EvalOptions options) {
       file_json["scores"][method]["seconds"] = seconds;
     };
     try {
-      // Models with the same scales and inputs share one feature matrix (features dominate
-      // the time).
+      // Ungated models with the same scales and inputs share one feature matrix (features
+      // dominate the time); a gated model chooses its network, and so its inputs, first.
       std::map<edges::FeatureParams, std::pair<edges::FeatureMatrix, double>> features_by_inputs;
       for (const auto& [method, model] : models) {
+        if (model.gated()) {
+          const edges::Classification result = edges::classify(cloud, model);
+          record(method, result.labels, result.features_s + result.inference_s);
+          file_json["scores"][method]["network"] = edges::network_name(result.gates);
+          continue;
+        }
         auto [entry, is_new] = features_by_inputs.try_emplace(model.config.feature_params());
         auto& [features, features_s] = entry->second;
         if (is_new) {
@@ -125,8 +131,6 @@ void run_eval(EvalOptions options) {
         }
         const edges::Classification result = edges::classify_features(features, model);
         record(method, result.labels, features_s + result.inference_s);
-        if (model.gated())
-          file_json["scores"][method]["network"] = model.network_name(result.gate_network_answered);
       }
       if (!options.predictions.empty()) {
         const std::string prediction_path = prediction_for(options.predictions, f, path);

@@ -29,20 +29,23 @@ void run_gate(const GateOptions& options) {
   const edges::GateKind kind =
       options.statistic == "noise" ? edges::GateKind::noise : edges::GateKind::sampling;
   const edges::Model model = edges::Model::load(options.model);
-  if (model.gated()) throw Error(options.model, "", "already has a gate");
+  if (model.gated())
+    throw Error(options.model, "", "already has a gate (the second model may hold one)");
   const edges::Model gate_model = edges::Model::load(options.gate_model);
   edges::Model gated;
   try {
     gated = model.with_gate(kind, gate_model, options.threshold);
   } catch (const Error& e) {  // the second network does not fit the first
     throw Error(options.gate_model, e.element(),
-                fmt::format("{} (it must have the classes, scales and layers of {})", e.reason(),
-                            options.model));
+                fmt::format("{} (it must have the config of {} but for its neighbour weights)",
+                            e.reason(), options.model));
   }
   gated.save(options.output);
-  fmt::print("{} ({} clouds) + {} ({} clouds), threshold {} -> {}\n", options.model,
-             gated.network_name(false), options.gate_model, gated.network_name(true),
-             options.threshold, options.output);
+  const auto name = [&](bool answered) {
+    return edges::network_name({{kind, options.threshold, 0.0, answered}});
+  };
+  fmt::print("{} ({} clouds) + {} ({} clouds), threshold {} -> {}\n", options.model, name(false),
+             options.gate_model, name(true), options.threshold, options.output);
 }
 
 }  // namespace
@@ -52,13 +55,17 @@ void register_edges_gate(CLI::App& edges) {
   CLI::App* command = edges.add_subcommand(
       "gate",
       "Join two BoundED networks into one gated model: the second network answers the clouds\n"
-      "the gate picks, the first every other cloud. Both need the same classes and scales.\n"
-      "  --statistic noise: a low-noise network answers a cloud when more than half of its\n"
-      "    points have a noise statistic below --threshold (sqrt(sigma_upper3 + sigma_lower3)\n"
-      "    at the smallest scale).\n"
+      "the gate picks, the first every other cloud. Both need the same classes, scales and\n"
+      "features per scale; they may weigh neighbours differently. The gate reads a sample of\n"
+      "the points before the features, so only the chosen network's features are computed.\n"
+      "The second model may be gated itself: a chain of networks, one answering each cloud.\n"
+      "  --statistic noise: a low-noise network answers a cloud when more than half of the\n"
+      "    points read (up to 16,384) have a noise statistic below --threshold\n"
+      "    (sqrt(sigma_upper3 + sigma_lower3) at the smallest scale, features of the first).\n"
       "  --statistic sampling: a mesh-vertex network answers a cloud whose spacings spread\n"
       "    like a tessellation's vertices: ln(P90 / P10) of the distance to the 8th nearest\n"
-      "    other point at least --threshold (about 0.45 on even samples).\n"
+      "    other point (up to 131,072 points read) at least --threshold (about 0.45 on even\n"
+      "    samples).\n"
       "See docs/edges.md, \"gate\".\n"
       "Examples:\n"
       "  glint edges gate noisy-3c.json clean-3c.json --threshold 0.01 -o gated-3c.json\n"

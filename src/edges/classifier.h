@@ -18,47 +18,40 @@ struct Classification {
   // between them in proportion to the thread time each took.
   double features_s = 0;
   double inference_s = 0;
-  // A gated model (Model::gated): the cloud's gate statistic (GateTally::statistic) and
-  // whether the gate's network answered.
-  double gate_statistic = 0;
-  bool gate_network_answered = false;
+  // A gated model: what each gate asked decided, first gate first (Model::answering_network).
+  std::vector<GateDecision> gates;
 };
 
 // Classifies every point. `scales` overrides the model's neighbourhood sizes (same count;
 // e.g. for a much denser or sparser cloud than the training data); empty = the model's.
-// A gated model keeps one network for the whole cloud: a sampling gate chooses it from the
-// spacings of the points sampling_gate_reads picks, before the features, and only it runs; a
-// noise gate reads the features, so both networks run on them and one answer is kept.
+// A gated model keeps one network of its chain for the whole cloud: once the neighbour search
+// is built, each gate reads the points gate_reads picks and passes the cloud on or not, and then
+// only the chosen network's features are computed and only it runs.
 Classification classify(const PointCloud& cloud, const Model& model,
                         const std::vector<int>& scales = {});
-// The network part alone, on features computed at the model's scale count (several models
-// with the same scales can share one feature matrix); features_s stays 0.
+// The network part alone, on features computed at the model's scale count and inputs (several
+// models with the same inputs can share one feature matrix); features_s stays 0. Throws
+// glint::Error for a gated model, whose gates choose before the features (use classify()).
 Classification classify_features(const FeatureMatrix& features, const Model& model);
 
-// One network of a model, the gate not asked: the gate's network or the model's own (tiled
-// classification asks the gate once for the whole file). Throws glint::Error when
-// `gate_network` is set for a model without a gate, and as classify().
-Classification classify_with_network(const PointCloud& cloud, const Model& model, bool gate_network,
-                                     const std::vector<int>& scales = {});
+// One network of a model's chain with its gate not asked (tiled classification asks the gates
+// once for the whole file): `network`'s own weights on features at its inputs. Throws as
+// classify().
+Classification classify_ungated(const PointCloud& cloud, const Model& network,
+                                const std::vector<int>& scales = {});
 
-// A sampling gate's tally of the points of `cloud` that `reads` marks (one entry per point),
-// their spacings as classify() finds them (tiled classification sums the tallies of every
-// tile's core points before it classifies a tile). Throws glint::Error for a model without a
-// sampling gate and when `cloud` has fewer points than the largest scale.
-GateTally sampling_gate_tally(const PointCloud& cloud, const Model& model,
-                              std::span<const std::uint8_t> reads,
-                              const std::vector<int>& scales = {});
-
-// Both answers of a noise-gated model for every point, the choice left open (tiled
-// classification makes it once for the whole file, from every tile's core points).
-struct GatedClassification {
-  Classification model_network;    // the model's own network
-  Classification gate_network;     // the gate's network
-  std::vector<float> gate_values;  // each point's noise statistic, for GateTally::add
-};
-// Throws glint::Error for a model without a noise gate, and as classify().
-GatedClassification classify_gated(const PointCloud& cloud, const Model& model,
-                                   const std::vector<int>& scales = {});
+// The bit of a point's gate-read mask that says a gate of this kind reads it (gate_reads).
+inline std::uint8_t gate_read_bit(GateKind kind) {
+  return kind == GateKind::noise ? std::uint8_t(1) : std::uint8_t(2);
+}
+// The tallies of every gate of the model's chain (Model::gate_chain), each over the points of
+// `cloud` whose mask in `reads` (one per point) has its kind's bit, their values as classify()
+// finds them (tiled classification sums the tallies of every tile's core points before it
+// classifies a tile). Throws glint::Error for a model without a gate, when `reads` has another
+// size and when `cloud` has fewer points than the largest scale.
+std::vector<GateTally> gate_tallies(const PointCloud& cloud, const Model& model,
+                                    std::span<const std::uint8_t> reads,
+                                    const std::vector<int>& scales = {});
 
 // Adds the output attributes of docs/edges.md: uchar scalar_label, float scalar_p_sharp,
 // float scalar_p_boundary, and uchar red/green/blue (red = sharp, green = boundary, grey = rest).

@@ -413,20 +413,30 @@ std::vector<float> squared_spacings(const PointCloud& cloud,
   return search.kth_nearest_squared_distances(k, [&](std::size_t done) { progress.advance(done); });
 }
 
-// Every point's features, written to row_for(point, scratch); row_written(scratch) follows
-// on the same thread. With `spacings_out` (one entry per point), also each point's squared
-// distance to its kAreaSpacingNeighbour-th nearest other point, read off its sorted
-// neighbourhood. search_ready as in compute_features_in_blocks. The cloud must have passed
-// check_cloud.
-template <class RowFor, class RowWritten>
-void compute_rows(const PointCloud& cloud, const FeatureParams& params,
-                  tbb::enumerable_thread_specific<Scratch>& scratches, RowFor&& row_for,
-                  RowWritten&& row_written, float* spacings_out, const SearchReady& search_ready) {
-  const PointKernel kernel = point_kernel();
+// The neighbour search of the features: built for the largest scale.
+geometry::NeighbourhoodParams search_params_for(const FeatureParams& params) {
   geometry::NeighbourhoodParams search_params;
   search_params.k = params.scales[0];
-  const geometry::NeighbourhoodSearch search(cloud, search_params);
-  if (search_ready) search_ready(search);
+  return search_params;
+}
+
+// Every point's features, written to row_for(point, scratch); row_written(scratch) follows
+// on the same thread. search_ready as in compute_features_in_blocks. The cloud must have passed
+// check_cloud.
+template <class RowFor, class RowWritten>
+void compute_rows(const PointCloud& cloud, const FeatureParams& given_params,
+                  tbb::enumerable_thread_specific<Scratch>& scratches, RowFor&& row_for,
+                  RowWritten&& row_written, const SearchReady& search_ready) {
+  const PointKernel kernel = point_kernel();
+  const geometry::NeighbourhoodSearch search(cloud, search_params_for(given_params));
+  FeatureParams params = given_params;
+  if (search_ready) {
+    params = search_ready(search);
+    FeatureParams same_rows = params;
+    same_rows.area_weights = given_params.area_weights;
+    if (same_rows != given_params)
+      throw Error("", "features", "a choice before the rows may change the neighbour weights only");
+  }
   // Handed out per neighbour with the positions, where the kernel weighs by them.
   const std::vector<float> spacings =
       params.area_weights ? squared_spacings(cloud, search) : std::vector<float>();
@@ -436,10 +446,6 @@ void compute_rows(const PointCloud& cloud, const FeatureParams& params,
         Scratch& scratch = scratches.local();
         kernel(nb, params, scratch, row_for(nb.point, scratch));
         row_written(scratch);
-        if (spacings_out) {
-          const int j = std::min(kAreaSpacingNeighbour, nb.size - 1);
-          spacings_out[nb.point] = nb.dx[j] * nb.dx[j] + nb.dy[j] * nb.dy[j] + nb.dz[j] * nb.dz[j];
-        }
       },
       [&](std::size_t done) { progress.advance(done); }, spacings);
   log().debug(
@@ -457,12 +463,38 @@ FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& par
   features.scales = static_cast<int>(params.scales.size());
   features.per_scale = params.per_scale();
   features.values.resize(features.points * features.row_size());
-  features.squared_spacings.resize(features.points);
   tbb::enumerable_thread_specific<Scratch> scratches;
   compute_rows(
       cloud, params, scratches, [&](std::uint32_t point, Scratch&) { return features.row(point); },
-      [](Scratch&) {}, features.squared_spacings.data(), {});
+      [](Scratch&) {}, {});
   return features;
+}
+
+std::vector<float> noise_statistics(const PointCloud& cloud, const FeatureParams& params,
+                                    std::span<const std::uint8_t> wanted) {
+  check_cloud(cloud, params);
+  // The statistic reads the smallest scale alone, whose values depend on its own k nearest
+  // only: a search for that k finds them for a fraction of the largest scale's cost.
+  FeatureParams smallest = params;
+  smallest.scales = {params.scales.back()};
+  const geometry::NeighbourhoodSearch search(cloud, search_params_for(smallest));
+  const PointKernel kernel = point_kernel();
+  const std::vector<float> spacings =
+      params.area_weights ? squared_spacings(cloud, search) : std::vector<float>();
+  std::vector<float> statistics(cloud.size(), 0.0f);
+  tbb::enumerable_thread_specific<Scratch> scratches([&] {
+    Scratch scratch;
+    scratch.block_rows.resize(smallest.row_size());
+    return scratch;
+  });
+  search.for_each(
+      [&](const geometry::Neighbourhood& nb) {
+        Scratch& scratch = scratches.local();
+        kernel(nb, smallest, scratch, scratch.block_rows.data());
+        statistics[nb.point] = noise_statistic(scratch.block_rows.data(), 1, smallest.per_scale());
+      },
+      {}, spacings, wanted);
+  return statistics;
 }
 
 void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& params,
@@ -488,7 +520,7 @@ void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& pa
         consume(scratch.block_points.data(), scratch.block_rows.data(), block_size);
         scratch.block_points.clear();
       },
-      nullptr, search_ready);
+      search_ready);
   // Each thread's last, partial block.
   for (Scratch& scratch : scratches) {
     if (scratch.block_points.empty()) continue;

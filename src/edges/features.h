@@ -34,6 +34,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <vector>
 
 #include "core/point_cloud.h"
@@ -75,9 +76,6 @@ struct FeatureMatrix {
   int scales = 0;
   int per_scale = kThesisFeaturesPerScale;
   std::vector<float> values;
-  // Per point, the squared distance to its kAreaSpacingNeighbour-th nearest other point: the
-  // local spacing the sampling gate of edges/model.h reads.
-  std::vector<float> squared_spacings;
 
   std::size_t row_size() const { return static_cast<std::size_t>(scales) * per_scale; }
   const float* row(std::size_t point) const { return values.data() + point * row_size(); }
@@ -98,10 +96,11 @@ FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& par
 // point comes in exactly one block. Same checks and errors as compute_features.
 // search_ready(search), when given, is called once before the first row with the cloud's
 // neighbour search (its largest k is the largest scale): a choice that depends on the whole
-// cloud, such as a sampling gate's, is made there, before any row is handed to `consume`.
+// cloud, such as a gate's, is made there, before any row is handed to `consume`. It returns the
+// params of the rows: `params` with other neighbour weights at most (glint::Error otherwise).
 using FeatureBlockConsumer =
     std::function<void(const std::uint32_t* points, const float* rows, std::size_t count)>;
-using SearchReady = std::function<void(const geometry::NeighbourhoodSearch& search)>;
+using SearchReady = std::function<FeatureParams(const geometry::NeighbourhoodSearch& search)>;
 void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& params,
                                 std::size_t block_size, const FeatureBlockConsumer& consume,
                                 const SearchReady& search_ready = {});
@@ -112,6 +111,13 @@ void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& pa
 // away from edges; it grows with displacement noise relative to the point spacing. The noise gate
 // of edges/model.h counts the points where it is below a threshold.
 float noise_statistic(const float* row, int scales, int per_scale);
+
+// noise_statistic of the points `wanted` marks (one entry per point; 0 elsewhere), as their
+// feature rows at `params` give it, from the smallest scale's features alone on a search of its
+// own (a grid for the smallest k). A sample costs what it holds, plus the grid and, with area
+// weights, a spacing pass over the cloud. Checks and errors as compute_features.
+std::vector<float> noise_statistics(const PointCloud& cloud, const FeatureParams& params,
+                                    std::span<const std::uint8_t> wanted);
 
 // Validates scales (>= 6, strictly decreasing); throws glint::Error naming the problem.
 void check_scales(const std::vector<int>& scales);

@@ -149,12 +149,11 @@ void Model::check() const {
   }
   if (gated()) {
     const std::string key = gate_key(gate_kind);
-    if (gate_network->gated()) throw Error(where, key, "the gate's network has a gate");
-    if (gate_network->config.classes != config.classes ||
-        gate_network->config.feature_params() != config.feature_params() ||
-        gate_network->layers.size() != layers.size())
+    ModelConfig other = gate_network->config;
+    other.area_weights = config.area_weights;
+    if (other != config)
       throw Error(where, key + "." + gate_network_key(gate_kind),
-                  "the gate's network must have the same classes, scales, inputs and layers");
+                  "the gate's network must have the model's config but for its neighbour weights");
     gate_network->check();
     if (!std::isfinite(gate_threshold) || gate_threshold <= 0.0f)
       throw Error(where, key + ".threshold",
@@ -172,9 +171,34 @@ Model Model::with_gate(GateKind kind, Model network, float threshold) const {
   return gated_model;
 }
 
-const char* Model::network_name(bool gate_network_answered) const {
-  if (gate_kind == GateKind::noise) return gate_network_answered ? "low-noise" : "noisy";
-  return gate_network_answered ? "mesh-vertex" : "default";
+std::vector<const Model*> Model::gate_chain() const {
+  std::vector<const Model*> chain;
+  for (const Model* network = this; network->gated(); network = network->gate_network.get())
+    chain.push_back(network);
+  return chain;
+}
+
+const Model& Model::answering_network(const std::vector<GateDecision>& decisions) const {
+  const Model* network = this;
+  for (const GateDecision& decision : decisions) {
+    if (!network->gated() || network->gate_kind != decision.kind)
+      throw Error("model", "gate", "the decisions do not fit the model's gates");
+    if (!decision.gate_network_answered) break;
+    network = network->gate_network.get();
+  }
+  return *network;
+}
+
+std::string network_name(const std::vector<GateDecision>& decisions) {
+  std::string name;
+  for (const GateDecision& decision : decisions) {
+    if (!name.empty()) name += '/';
+    if (decision.kind == GateKind::noise)
+      name += decision.gate_network_answered ? "low-noise" : "noisy";
+    else
+      name += decision.gate_network_answered ? "mesh-vertex" : "default";
+  }
+  return name;
 }
 
 GateTally::GateTally(GateKind kind, float threshold)
@@ -221,9 +245,10 @@ bool GateTally::gate_network_answers() const {
   return points() > 0 && statistic() >= threshold_;
 }
 
-bool sampling_gate_reads(std::uint64_t index, std::uint64_t points) {
-  if (points <= kSamplingGatePoints) return true;
-  return mix64(index) < std::numeric_limits<std::uint64_t>::max() / points * kSamplingGatePoints;
+bool gate_reads(GateKind kind, std::uint64_t index, std::uint64_t points) {
+  const std::uint64_t sample = gate_sample_size(kind);
+  if (points <= sample) return true;
+  return mix64(index) < std::numeric_limits<std::uint64_t>::max() / points * sample;
 }
 
 namespace {
@@ -288,6 +313,67 @@ void read_network(const io::JsonFields& reader, const nlohmann::json& object,
   }
 }
 
+const char* weights_name(const ModelConfig& config) {
+  return config.area_weights ? "area" : "count";
+}
+
+// The optional "neighbour_weights" of `object`: whether neighbours weigh by area (`otherwise`
+// where the key is missing, as in files of earlier versions).
+bool read_area_weights(const io::JsonFields& reader, const nlohmann::json& object,
+                       const std::string& where, bool otherwise) {
+  if (!object.contains("neighbour_weights")) return otherwise;
+  const std::string weights = reader.string(object, "neighbour_weights", where);
+  if (weights != "count" && weights != "area")
+    reader.fail(io::key_path(where, "neighbour_weights"),
+                fmt::format("expected \"count\" or \"area\", got \"{}\"", weights));
+  return weights == "area";
+}
+
+// The model's gate into `object`: statistic, threshold and the gate's network, whose object
+// holds its neighbour weights and its own gate.
+void add_gate_json(const Model& model, nlohmann::json& object) {
+  if (!model.gated()) return;
+  nlohmann::json network = network_json(*model.gate_network);
+  network["neighbour_weights"] = weights_name(model.gate_network->config);
+  add_gate_json(*model.gate_network, network);
+  const char* statistic = model.gate_kind == GateKind::noise
+                              ? "sqrt(sigma_upper(3) + sigma_lower(3)), smallest scale"
+                              : "ln(P90 / P10) of the distance to the 8th nearest other point";
+  object[gate_key(model.gate_kind)] = {{"statistic", statistic},
+                                       {"threshold", io::exact_float(model.gate_threshold)},
+                                       {gate_network_key(model.gate_kind), network}};
+}
+
+// The gate of `object` (key path `where`), if it holds one, into `model`, whose network is read;
+// the gate's network takes the model's config but for its neighbour weights.
+void read_gate(const io::JsonFields& reader, const nlohmann::json& object, const std::string& where,
+               Model& model) {
+  for (const GateKind kind : {GateKind::noise, GateKind::sampling}) {
+    const auto gate = object.find(gate_key(kind));
+    if (gate == object.end()) continue;
+    const std::string key = io::key_path(where, gate_key(kind));
+    if (model.gated()) reader.fail(key, "a model holds one gate; this one has two");
+    if (!gate->is_object()) reader.fail(key, "expected an object");
+    const nlohmann::json& network_object = reader.member(*gate, gate_network_key(kind), key);
+    const std::string network_key = key + "." + gate_network_key(kind);
+    ModelConfig config = model.config;
+    config.area_weights =
+        read_area_weights(reader, network_object, network_key, model.config.area_weights);
+    Model network(config);
+    read_network(reader, network_object, network_key, network);
+    read_gate(reader, network_object, network_key, network);
+    model.gate_threshold =
+        reader.finite_float(reader.member(*gate, "threshold", key), key + ".threshold");
+    model.gate_kind = kind;
+    model.gate_network = std::make_shared<const Model>(std::move(network));
+    try {
+      model.check();
+    } catch (const Error& e) {
+      reader.fail(e.element(), e.reason());
+    }
+  }
+}
+
 }  // namespace
 
 nlohmann::json Model::to_json() const {
@@ -297,20 +383,13 @@ nlohmann::json Model::to_json() const {
                          {"classes", class_names(config.classes)},
                          {"scales", config.scales},
                          {"features_per_scale", config.features_per_scale()},
-                         {"neighbour_weights", config.area_weights ? "area" : "count"},
+                         {"neighbour_weights", weights_name(config)},
                          {"fusion_width", config.fusion_width},
                          {"hidden", config.hidden},
                          {"hidden_layers", config.hidden_layers},
                          {"leaky_slope", io::exact_float(config.leaky_slope)}};
   root.update(network_json(*this));
-  if (gated()) {
-    const char* statistic = gate_kind == GateKind::noise
-                                ? "sqrt(sigma_upper(3) + sigma_lower(3)), smallest scale"
-                                : "ln(P90 / P10) of the distance to the 8th nearest other point";
-    root[gate_key(gate_kind)] = {{"statistic", statistic},
-                                 {"threshold", io::exact_float(gate_threshold)},
-                                 {gate_network_key(gate_kind), network_json(*gate_network)}};
-  }
+  add_gate_json(*this, root);
   return root;
 }
 
@@ -337,14 +416,7 @@ Model Model::load(const std::string& path) {
 
   ModelConfig config;
   config.angular_gap = features == features_per_scale(true);
-  // The key is optional: without it (files of earlier versions) neighbours weigh 1.
-  if (root.contains("neighbour_weights")) {
-    const std::string weights = reader.string(root, "neighbour_weights");
-    if (weights != "count" && weights != "area")
-      reader.fail("neighbour_weights",
-                  fmt::format("expected \"count\" or \"area\", got \"{}\"", weights));
-    config.area_weights = weights == "area";
-  }
+  config.area_weights = read_area_weights(reader, root, "", false);
   config.classes = class_count;
   config.scales = reader.integers(root, "scales");
   config.fusion_width = reader.integer(root, "fusion_width");
@@ -359,25 +431,7 @@ Model Model::load(const std::string& path) {
 
   Model model(config);
   read_network(reader, root, "", model);
-  for (const GateKind kind : {GateKind::noise, GateKind::sampling}) {
-    const std::string key = gate_key(kind);
-    const auto gate = root.find(key);
-    if (gate == root.end()) continue;
-    if (model.gated()) reader.fail(key, "a model holds one gate; this one has two");
-    if (!gate->is_object()) reader.fail(key, "expected an object");
-    const std::string network_key = key + "." + gate_network_key(kind);
-    Model network(config);
-    read_network(reader, reader.member(*gate, gate_network_key(kind), key), network_key, network);
-    model.gate_threshold =
-        reader.finite_float(reader.member(*gate, "threshold", key), key + ".threshold");
-    model.gate_kind = kind;
-    model.gate_network = std::make_shared<const Model>(std::move(network));
-    try {
-      model.check();
-    } catch (const Error& e) {
-      reader.fail(e.element(), e.reason());
-    }
-  }
+  read_gate(reader, root, "", model);
   return model;
 }
 

@@ -16,9 +16,10 @@
 //
 // Classes: index = glint point label: 0 non-edge, 1 sharp edge, 2 boundary (C = 3 only).
 //
-// A model file may hold a gate: a second network of the same config that answers a whole cloud
-// instead of the first when the cloud's gate statistic says so (GateKind; docs/edges.md,
-// "gate").
+// A model file may hold a gate: a second network of the same config but for its neighbour
+// weights that answers a whole cloud instead of the first when the cloud's gate statistic says so
+// (GateKind; docs/edges.md, "gate"). The second network may hold a gate of its own, so a file
+// holds a chain of networks; each cloud gets one of them.
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -43,6 +44,7 @@ struct ModelConfig {
   // Input columns of the network: the feature row of one point.
   std::size_t input_columns() const { return scales.size() * std::size_t(features_per_scale()); }
   FeatureParams feature_params() const { return FeatureParams{scales, angular_gap, area_weights}; }
+  bool operator==(const ModelConfig&) const = default;
 };
 
 // Throws glint::Error when a config cannot describe a network: classes not 2 or 3, scale
@@ -63,10 +65,11 @@ struct DenseLayer {
 // then the hidden layers; then the output layer), with zero weights.
 std::vector<DenseLayer> make_layers(const ModelConfig& config);
 
-// What a gate reads from each point and when its network answers the whole cloud.
+// What a gate reads from each point it reads (gate_reads) and when its network answers the
+// whole cloud. Both read before the cloud's features, so only the chosen network runs.
 enum class GateKind {
-  // More than half of the points have edges::noise_statistic below the threshold: a network
-  // trained on clean clouds.
+  // More than half of the points have edges::noise_statistic below the threshold, from feature
+  // rows of the gated model's own inputs: a network trained on clean clouds.
   noise,
   // The spread of the points' spacings, ln(P90 / P10) of the distance to the
   // kAreaSpacingNeighbour-th nearest other point, is at least the threshold: a network trained
@@ -83,7 +86,8 @@ class GateTally {
   static constexpr int kLogRange = 40;
 
   GateTally(GateKind kind, float threshold);
-  // One point's value: its noise statistic or its squared spacing (FeatureMatrix).
+  // One point's value: its noise statistic, or the squared distance to its
+  // kAreaSpacingNeighbour-th nearest other point.
   void add(float value);
   // Adds another tally of the same gate (a tile's).
   void merge(const GateTally& other);
@@ -101,13 +105,30 @@ class GateTally {
   std::vector<std::uint64_t> counts_;
 };
 
-// The points a sampling gate reads: every point of a cloud of up to kSamplingGatePoints, and
-// about that many of a larger one, picked by a hash of the input index. Their spacings are
-// searched before the features, so the gate chooses first and one network runs; a tiled file
-// picks the same points as the whole cloud. A sample this large puts ln(P90 / P10) within a bin
-// or two of the whole cloud's.
+// The points a gate reads: every point of a cloud of up to gate_sample_size(kind), and about
+// that many of a larger one, picked by a hash of the input index, so a tiled file picks the same
+// points as the whole cloud. A sampling gate's 2^17 spacings put ln(P90 / P10) within a bin or
+// two of the whole cloud's; a noise gate's 2^14 feature rows put the share of quiet points
+// within about 1 % of it (binomial standard error at most 0.4 %) at the cost of 2^14 points'
+// features.
 inline constexpr std::uint64_t kSamplingGatePoints = std::uint64_t(1) << 17;
-bool sampling_gate_reads(std::uint64_t index, std::uint64_t points);
+inline constexpr std::uint64_t kNoiseGatePoints = std::uint64_t(1) << 14;
+inline std::uint64_t gate_sample_size(GateKind kind) {
+  return kind == GateKind::sampling ? kSamplingGatePoints : kNoiseGatePoints;
+}
+bool gate_reads(GateKind kind, std::uint64_t index, std::uint64_t points);
+
+// What one gate decided for a cloud (or a file), for logs and reports.
+struct GateDecision {
+  GateKind kind = GateKind::noise;
+  float threshold = 0;
+  double statistic = 0;  // GateTally::statistic
+  bool gate_network_answered = false;
+};
+// The name of the network that answered after these decisions (first gate first): each
+// decision's "mesh-vertex" or "default" (sampling), "low-noise" or "noisy" (noise), joined by
+// "/"; empty for an ungated model.
+std::string network_name(const std::vector<GateDecision>& decisions);
 
 class Model {
  public:
@@ -121,16 +142,20 @@ class Model {
   std::vector<DenseLayer> layers;  // see make_layers
   nlohmann::json training_info = nlohmann::json::object();  // free-form: how it was trained
 
-  // The gate (none when gate_network is null): gate_network has this config and no gate.
+  // The gate (none when gate_network is null): gate_network has this model's config but for
+  // the neighbour weights, and may hold a gate of its own.
   std::shared_ptr<const Model> gate_network;
   GateKind gate_kind = GateKind::noise;
   float gate_threshold = 0;  // > 0, in the units of the gate's statistic (GateTally)
   bool gated() const { return gate_network != nullptr; }
   GateTally new_tally() const { return GateTally(gate_kind, gate_threshold); }
-  // The names of the model's own network and of the gate's, for logs and reports.
-  const char* network_name(bool gate_network_answered) const;
-  // This model with `network` behind a gate (checks that the configs match and the threshold is
-  // finite and > 0; throws glint::Error).
+  // The chain of gated networks, this model first: each holds a gate, the next is its network.
+  std::vector<const Model*> gate_chain() const;
+  // The network that answers after `decisions` (first gate first; fewer than the chain holds
+  // where a gate's own network answered).
+  const Model& answering_network(const std::vector<GateDecision>& decisions) const;
+  // This model with `network` (gated or not) behind a gate (checks that the configs match but
+  // for the neighbour weights and the threshold is finite and > 0; throws glint::Error).
   Model with_gate(GateKind kind, Model network, float threshold) const;
 
   static constexpr float kMinInputStd = 1e-6f;

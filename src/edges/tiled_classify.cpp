@@ -41,10 +41,10 @@ void put_result(const Classification& result, std::size_t i, std::uint8_t* recor
 // A tile's point as stored in its bucket file.
 struct TilePoint {
   float x, y, z;
-  std::uint32_t flags;  // kCore | kGateReads
+  std::uint32_t flags;  // kCore, and a core point's gate-read mask << kGateReadsShift
 };
-constexpr std::uint32_t kCore = 1;       // the tile's own point (else a halo point)
-constexpr std::uint32_t kGateReads = 2;  // a core point whose spacing a sampling gate reads
+constexpr std::uint32_t kCore = 1;  // the tile's own point (else a halo point)
+constexpr int kGateReadsShift = 1;  // gate_tallies's read mask (edges/classifier.h)
 
 // The rows [begin, end) of the input that rank `rank` of `ranks` streams in every pass.
 std::pair<std::uint64_t, std::uint64_t> slice_of(std::uint64_t points, int rank, int ranks) {
@@ -373,7 +373,14 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
   std::uint64_t tile_limit = (limit - kFixedBytes) / kTileBytesPerPoint;
   if (params.tile_points > 0) tile_limit = std::min(tile_limit, params.tile_points);
 
-  const bool sampling_gate = model.gated() && model.gate_kind == GateKind::sampling;
+  const std::vector<const Model*> gate_chain = model.gate_chain();
+  // The gates that read the point of input index `index` (the same points as in the whole cloud).
+  auto read_mask = [&](std::uint64_t index) {
+    std::uint32_t mask = 0;
+    for (const Model* gated : gate_chain)
+      if (gate_reads(gated->gate_kind, index, n)) mask |= gate_read_bit(gated->gate_kind);
+    return mask;
+  };
   TiledClassifyStats stats;
   stats.points = n;
   stats.points_per_tile_limit = tile_limit;
@@ -426,8 +433,7 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
     } catch (const Error& e) {
       throw Error(input, e.element(), e.reason());
     }
-    stats.gate_statistic = result.gate_statistic;
-    stats.gate_network_answered = result.gate_network_answered;
+    stats.gates = result.gates;
     stats.classify_s = watch.elapsed_s();
     cloud = PointCloud();
     watch.restart();
@@ -537,7 +543,7 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
           for (std::size_t j = 0; j < count; ++j) {
             std::int32_t xyz[3];
             io::las_record_xyz(records + j * in_length, xyz);
-            const bool gate_reads = sampling_gate && sampling_gate_reads(first + j, n);
+            const std::uint32_t reads = read_mask(first + j);
             const std::int64_t ux = std::int64_t(xyz[0]) - grid.low[0];
             const std::int64_t uy = std::int64_t(xyz[1]) - grid.low[1];
             const std::size_t own = core_tile(xyz);
@@ -566,7 +572,7 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
                   buckets[t].reset(open_file(bucket_path(t, rank), "wb", file_buffers[t]));
                 }
                 TilePoint stored = point;
-                stored.flags = t == own ? kCore | (gate_reads ? kGateReads : 0) : 0;
+                stored.flags = t == own ? kCore | reads << kGateReadsShift : 0;
                 write_all(buckets[t].get(), &stored, sizeof stored, bucket_path(t, rank));
                 if (t == own) ++tile_counts[t * std::size_t(ranks) + std::size_t(rank)];
                 ++tile_counts[tile_count * std::size_t(ranks) + t];
@@ -644,47 +650,47 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
   std::vector<std::uint8_t> flags;
   const bool was_quiet = is_quiet();
 
-  // A sampling gate chooses the file's network before any tile is classified, from the spacings
-  // of the core points it reads (the same points as in the whole cloud).
+  // The gates choose the file's network before any tile is classified, each from the core
+  // points it reads (the same points as in the whole cloud).
   watch.restart();
-  GateTally tally = model.new_tally();
-  if (sampling_gate) {
+  const Model* network = &model;
+  if (model.gated()) {
+    std::vector<GateTally> tallies;
+    for (const Model* gated : gate_chain) tallies.push_back(gated->new_tally());
     ProgressBar progress("gate", rank_points);
     for (const std::size_t t : mine) {
       load_tile(t, cloud, flags);
       std::vector<std::uint8_t> reads(flags.size());
-      for (std::size_t i = 0; i < flags.size(); ++i) reads[i] = (flags[i] & kGateReads) ? 1 : 0;
+      for (std::size_t i = 0; i < flags.size(); ++i)
+        reads[i] = (flags[i] & kCore) ? std::uint8_t(flags[i] >> kGateReadsShift) : 0;
       try {
-        tally.merge(sampling_gate_tally(cloud, model, reads, scales));
+        const std::vector<GateTally> tile_tallies = gate_tallies(cloud, model, reads, scales);
+        for (std::size_t g = 0; g < tallies.size(); ++g) tallies[g].merge(tile_tallies[g]);
       } catch (const Error& e) {
         throw Error(input, e.element(), fmt::format("tile {}: {}", t, e.reason()));
       }
       progress.advance(tile_core[t]);
     }
     progress.finish();
-    world.sum(tally.counts());
-    stats.gate_statistic = tally.statistic();
-    stats.gate_network_answered = tally.gate_network_answers();
+    for (std::size_t g = 0; g < tallies.size(); ++g) {
+      world.sum(tallies[g].counts());
+      const Model& gated = *gate_chain[g];
+      stats.gates.push_back({gated.gate_kind, gated.gate_threshold, tallies[g].statistic(),
+                             tallies[g].gate_network_answers()});
+      if (!stats.gates.back().gate_network_answered) break;
+    }
+    network = &model.answering_network(stats.gates);
   }
 
-  // Per tile: classify core and halo together, keep the core's results in input order. A noise
-  // gate reads the features, so a noise-gated model's tile keeps both networks' results and
-  // the file's choice comes after the last tile.
-  const bool both_answers = model.gated() && !sampling_gate;
-  const std::size_t record_bytes = both_answers ? 2 * kResultBytes : kResultBytes;
+  // Per tile: classify core and halo together, keep the core's results in input order.
   {
     ProgressBar progress("classify", rank_points);
     for (const std::size_t t : mine) {
       load_tile(t, cloud, flags);
       set_quiet(true);  // one bar over all tiles, not one per tile
-      GatedClassification result;
+      Classification result;
       try {
-        if (both_answers) {
-          result = classify_gated(cloud, model, scales);
-        } else {
-          result.model_network =
-              classify_with_network(cloud, model, stats.gate_network_answered, scales);
-        }
+        result = classify_ungated(cloud, *network, scales);
       } catch (const Error& e) {
         set_quiet(was_quiet);
         throw Error(input, e.element(), fmt::format("tile {}: {}", t, e.reason()));
@@ -694,13 +700,9 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
       File results(open_file(result_path, "wb", file_buffer));
       for (std::size_t i = 0; i < cloud.size(); ++i) {
         if (!(flags[i] & kCore)) continue;
-        std::uint8_t record[2 * kResultBytes];
-        put_result(result.model_network, i, record);
-        if (both_answers) {
-          put_result(result.gate_network, i, record + kResultBytes);
-          tally.add(result.gate_values[i]);
-        }
-        write_all(results.get(), record, record_bytes, result_path.string());
+        std::uint8_t record[kResultBytes];
+        put_result(result, i, record);
+        write_all(results.get(), record, kResultBytes, result_path.string());
       }
       if (std::fflush(results.get()) != 0) {
         throw Error(result_path.string(), "", "cannot write a temporary tile file");
@@ -713,12 +715,6 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
   }
   cloud = PointCloud();
   stats.classify_s = watch.elapsed_s();
-  if (both_answers) {  // one choice of network for the whole file
-    world.sum(tally.counts());
-    stats.gate_statistic = tally.statistic();
-    stats.gate_network_answered = tally.gate_network_answers();
-  }
-  const std::size_t result_offset = both_answers && stats.gate_network_answered ? kResultBytes : 0;
   world.barrier();
 
   // Pass 4: the output, in input order; each point takes the next result of its core tile.
@@ -733,7 +729,7 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
       file_buffers[t].resize(1 << 15);
       const std::filesystem::path path = folder.path / fmt::format("t{}.res", t);
       results[t].reset(open_file(path, "rb", file_buffers[t]));
-      if (::fseeko(results[t].get(), off_t(before * record_bytes), SEEK_SET) != 0) {
+      if (::fseeko(results[t].get(), off_t(before * kResultBytes), SEEK_SET) != 0) {
         throw Error(path.string(), "", "cannot seek in a temporary tile file");
       }
     }
@@ -745,16 +741,15 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
                                    std::int32_t xyz[3];
                                    io::las_record_xyz(record, xyz);
                                    const std::size_t t = core_tile(xyz);
-                                   std::uint8_t bytes[2 * kResultBytes];
+                                   std::uint8_t bytes[kResultBytes];
                                    if (!results[t] ||
-                                       std::fread(bytes, record_bytes, 1, results[t].get()) != 1) {
+                                       std::fread(bytes, kResultBytes, 1, results[t].get()) != 1) {
                                      throw Error(folder.path.string(), "",
                                                  fmt::format("tile {} has too few results", t));
                                    }
-                                   const std::uint8_t* chosen = bytes + result_offset;
-                                   label = chosen[0];
-                                   std::memcpy(&p_sharp, chosen + 1, 4);
-                                   std::memcpy(&p_boundary, chosen + 5, 4);
+                                   label = bytes[0];
+                                   std::memcpy(&p_sharp, bytes + 1, 4);
+                                   std::memcpy(&p_boundary, bytes + 5, 4);
                                  });
                    });
   }

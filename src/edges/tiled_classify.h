@@ -14,9 +14,9 @@
 // Passes over the input, each streaming fixed-size chunks: bounding box; cell counts; bucketing
 // of every point into the tiles whose core or halo holds it (temporary files next to the
 // output); per tile: classification; the output, written in input order with each point's
-// results from its core tile. A gated model keeps both networks' results per tile and
-// chooses one network for the whole file from the gate tally of all tiles' cores, as the
-// whole-cloud run does. With R ranks each reads 1/R of the input in every pass and
+// results from its core tile. A gated model's gates first tally the cores of every tile and
+// choose one network for the whole file, as the whole-cloud run does, before any tile is
+// classified. With R ranks each reads 1/R of the input in every pass and
 // classifies its share of the tiles; all write their part of one output file.
 //
 // Positions become float relative to the file's integer origin (io/las.h) in every tile and in
@@ -41,9 +41,8 @@ struct TiledClassifyParams {
 struct TiledClassifyStats {
   std::uint64_t points = 0;
   std::uint64_t labels[3] = {0, 0, 0};  // non-edge, sharp, boundary
-  // A gated model: the gate statistic of the whole file and the network chosen for all of it.
-  double gate_statistic = 0;
-  bool gate_network_answered = false;
+  // A gated model: what its gates decided for the whole file (Classification::gates).
+  std::vector<GateDecision> gates;
   bool tiled = false;
   std::size_t tiles = 0;          // non-empty tiles
   std::uint64_t halo_points = 0;  // summed over tiles (points read twice or more)

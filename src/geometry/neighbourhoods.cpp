@@ -510,9 +510,34 @@ NeighbourhoodSearch::NeighbourhoodSearch(const PointCloud& cloud,
 
 NeighbourhoodSearch::~NeighbourhoodSearch() = default;
 
+namespace {
+
+// Throws when a mask of wanted points (empty: every point) does not fit the cloud.
+void check_wanted(std::span<const std::uint8_t> wanted, std::size_t points, const char* element) {
+  if (!wanted.empty() && wanted.size() != points) {
+    throw Error("", element,
+                "the mask of wanted points has " + std::to_string(wanted.size()) + " entries for " +
+                    std::to_string(points) + " points");
+  }
+}
+
+// Whether the point in `slot` is wanted, and whether any point of slots [begin, end) is.
+bool slot_wanted(const Grid& grid, std::span<const std::uint8_t> wanted, std::uint32_t slot) {
+  return wanted.empty() || wanted[grid.original[slot]] != 0;
+}
+bool any_slot_wanted(const Grid& grid, std::span<const std::uint8_t> wanted, std::uint32_t begin,
+                     std::uint32_t end) {
+  for (std::uint32_t slot = begin; slot < end; ++slot)
+    if (slot_wanted(grid, wanted, slot)) return true;
+  return false;
+}
+
+}  // namespace
+
 NeighbourhoodStats NeighbourhoodSearch::for_each(
     const std::function<void(const Neighbourhood&)>& visit,
-    const std::function<void(std::size_t)>& progress, std::span<const float> values) const {
+    const std::function<void(std::size_t)>& progress, std::span<const float> values,
+    std::span<const std::uint8_t> wanted) const {
   const int k = state_->k;
   const Grid& grid = state_->grid;
   const std::size_t n = grid.original.size();
@@ -521,6 +546,7 @@ NeighbourhoodStats NeighbourhoodSearch::for_each(
         "", "neighbourhood search",
         "has " + std::to_string(values.size()) + " values for " + std::to_string(n) + " points");
   }
+  check_wanted(wanted, n, "neighbourhood search");
   // In slot order, so that a block's values are gathered with its positions (neighbours' values
   // looked up by cloud index would be cache misses).
   std::vector<float> slot_values(values.size());
@@ -562,9 +588,12 @@ NeighbourhoodStats NeighbourhoodSearch::for_each(
     std::size_t done = 0;
     for (std::size_t cell_id = first_cell; cell_id < end_cell; ++cell_id) {
       const std::uint32_t begin = grid.cell_begin[cell_id], end = grid.cell_begin[cell_id + 1];
+      done += end - begin;
+      if (!any_slot_wanted(grid, wanted, begin, end)) continue;
       scratch.retry.clear();
       gather_block(grid, cell_id, kBlockRadius, scratch, lower, upper, carried);
       for (std::uint32_t slot = begin; slot < end; ++slot) {
+        if (!slot_wanted(grid, wanted, slot)) continue;
         if (select(grid, slot, lower, upper, k, scratch)) {
           emit(slot, scratch);
         } else {
@@ -592,7 +621,6 @@ NeighbourhoodStats NeighbourhoodSearch::for_each(
           emit(slot, scratch);
         }
       }
-      done += end - begin;
     }
     if (progress) progress(done);
   });
@@ -717,14 +745,7 @@ std::vector<float> NeighbourhoodSearch::kth_nearest_squared_distances(
                 "the cloud has " + std::to_string(cloud.size()) +
                     " points, fewer than k = " + std::to_string(k));
   }
-  if (!wanted.empty() && wanted.size() != cloud.size()) {
-    throw Error("", "k-th neighbour distances",
-                "the mask of wanted points has " + std::to_string(wanted.size()) + " entries for " +
-                    std::to_string(cloud.size()) + " points");
-  }
-  const auto is_wanted = [&](std::uint32_t slot) {
-    return wanted.empty() || wanted[grid.original[slot]] != 0;
-  };
+  check_wanted(wanted, cloud.size(), "k-th neighbour distances");
   const std::size_t cells = grid.cell_begin.size() - 1;
   const KthKernel kth_candidate_distance = kth_kernel();
   std::vector<float> result(cloud.size(), 0.0f);
@@ -735,14 +756,11 @@ std::vector<float> NeighbourhoodSearch::kth_nearest_squared_distances(
     for (std::size_t cell_id = first_cell; cell_id < end_cell; ++cell_id) {
       const std::uint32_t begin = grid.cell_begin[cell_id], end = grid.cell_begin[cell_id + 1];
       scratch.retry.clear();
-      bool any_wanted = false;
-      for (std::uint32_t slot = begin; slot < end && !any_wanted; ++slot)
-        any_wanted = is_wanted(slot);
-      if (!any_wanted) continue;
+      if (!any_slot_wanted(grid, wanted, begin, end)) continue;
       // The cells are sized for the larger k, so one cell around usually holds the k nearest.
       gather_block(grid, cell_id, 1, scratch, lower, upper);
       for (std::uint32_t slot = begin; slot < end; ++slot) {
-        if (!is_wanted(slot)) continue;
+        if (!slot_wanted(grid, wanted, slot)) continue;
         const float qx = grid.xs[slot], qy = grid.ys[slot], qz = grid.zs[slot];
         const float kth = kth_candidate_distance(qx, qy, qz, k, scratch);
         const double guaranteed = guaranteed_radius(qx, qy, qz, lower, upper);

@@ -65,10 +65,13 @@ class NeighbourhoodSearch {
   // must be thread-safe; the Neighbourhood's arrays are valid only during the call).
   // progress(points_done) is called now and then from worker threads (may be empty).
   // values, one per point when given, are handed out per neighbour (Neighbourhood::values),
-  // gathered with the positions. Throws glint::Error when values has another size.
+  // gathered with the positions. With `wanted`, only the points with a non-zero entry are
+  // visited (cells without one are skipped). Throws glint::Error when values or wanted has
+  // another size.
   NeighbourhoodStats for_each(const std::function<void(const Neighbourhood&)>& visit,
                               const std::function<void(std::size_t)>& progress = {},
-                              std::span<const float> values = {}) const;
+                              std::span<const float> values = {},
+                              std::span<const std::uint8_t> wanted = {}) const;
 
   // Every point's exact squared distance to its k-th nearest point, itself counted first (k = 9
   // gives the 8th nearest other point): a local spacing, for k up to params.k. The block of one

@@ -68,18 +68,10 @@ TEST(NoiseStatistic, IsZeroOnACleanPlaneAndGrowsWithTheNoise) {
 
 // Every point answered by one network of constant_model(1) gated with constant_model(0).
 void expect_answered_by(const Classification& result, bool gate_network, std::size_t points) {
-  EXPECT_EQ(result.gate_network_answered, gate_network);
+  ASSERT_EQ(result.gates.size(), 1u);
+  EXPECT_EQ(result.gates[0].gate_network_answered, gate_network);
   const std::uint8_t label = gate_network ? 0 : 1;
   EXPECT_EQ(std::count(result.labels.begin(), result.labels.end(), label), std::ptrdiff_t(points));
-}
-
-// On a feature matrix computed apart, the same choice, statistic and labels as in one pass.
-void expect_apart_as_fused(const PointCloud& cloud, const Model& gated) {
-  const Classification fused = classify(cloud, gated);
-  const Classification apart = classify_features(compute_features(cloud), gated);
-  EXPECT_EQ(apart.gate_network_answered, fused.gate_network_answered);
-  EXPECT_EQ(apart.gate_statistic, fused.gate_statistic);
-  EXPECT_EQ(apart.labels, fused.labels);
 }
 
 TEST(NoiseGate, ChoosesTheLowNoiseNetworkOnlyForAQuietCloud) {
@@ -88,25 +80,16 @@ TEST(NoiseGate, ChoosesTheLowNoiseNetworkOnlyForAQuietCloud) {
 
   const Classification quiet = classify(clean, gated);
   expect_answered_by(quiet, true, clean.size());
-  EXPECT_EQ(quiet.gate_statistic, 1.0);  // every point quiet
+  EXPECT_EQ(quiet.gates[0].statistic, 1.0);  // every point quiet
+  EXPECT_EQ(quiet.gates[0].kind, GateKind::noise);
+  EXPECT_EQ(quiet.gates[0].threshold, 0.1f);
+  EXPECT_EQ(network_name(quiet.gates), "low-noise");
   const Classification loud = classify(noisy, gated);
   expect_answered_by(loud, false, noisy.size());
-  EXPECT_LT(loud.gate_statistic, 0.5);
-
-  for (const PointCloud* cloud : {&clean, &noisy}) expect_apart_as_fused(*cloud, gated);
-}
-
-TEST(NoiseGate, BothAnswersAreKeptWhenTheChoiceIsLeftOpen) {
-  const Model gated = constant_model(2).with_gate(GateKind::noise, constant_model(1), 0.1f);
-  const PointCloud cloud = noisy_plane(0.0f, 1);
-  const GatedClassification both = classify_gated(cloud, gated);
-  ASSERT_EQ(both.gate_values.size(), cloud.size());
-  EXPECT_EQ(both.model_network.labels, std::vector<std::uint8_t>(cloud.size(), 2));
-  EXPECT_EQ(both.gate_network.labels, std::vector<std::uint8_t>(cloud.size(), 1));
-  EXPECT_THROW(classify_gated(cloud, constant_model(2)), Error);
-  EXPECT_THROW(classify_gated(
-                   cloud, constant_model(2).with_gate(GateKind::sampling, constant_model(1), 1.f)),
-               Error);
+  EXPECT_LT(loud.gates[0].statistic, 0.5);
+  EXPECT_EQ(network_name(loud.gates), "noisy");
+  // The gate chooses before the features: no feature matrix serves a gated model.
+  EXPECT_THROW(classify_features(compute_features(clean), gated), Error);
 }
 
 // A noise tally of `quiet` values below the threshold 0.1 and `loud` above it.
@@ -129,12 +112,108 @@ TEST(NoiseGate, RejectsNetworksThatDoNotFitAndBadThresholds) {
   ModelConfig other_scales;
   other_scales.scales = {64, 32, 16, 8};
   EXPECT_THROW(constant_model(1).with_gate(GateKind::sampling, Model(other_scales), 0.1f), Error);
+  ModelConfig with_gap;
+  with_gap.angular_gap = true;
+  EXPECT_THROW(constant_model(1).with_gate(GateKind::sampling, Model(with_gap), 0.1f), Error);
+  ModelConfig wider;
+  wider.hidden = 32;
+  EXPECT_THROW(constant_model(1).with_gate(GateKind::sampling, Model(wider), 0.1f), Error);
   EXPECT_THROW(constant_model(1).with_gate(GateKind::noise, constant_model(0), 0.0f), Error);
   EXPECT_THROW(constant_model(1).with_gate(GateKind::sampling, constant_model(0), std::nanf("")),
                Error);
   const Model gated = constant_model(1).with_gate(GateKind::noise, constant_model(0), 0.1f);
   EXPECT_THROW(gated.with_gate(GateKind::noise, constant_model(0), 0.1f), Error);
-  EXPECT_THROW(constant_model(1).with_gate(GateKind::sampling, gated, 0.1f), Error);
+}
+
+// The noise statistic of every point as the gate reads it, the share of quiet points of a sample
+// as of the whole cloud: half a clean plane, half a noisy one, side by side.
+TEST(NoiseGate, ALargeCloudsSampleIsAsQuietAsTheWholeCloud) {
+  PointCloud cloud;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<float> noise(0.0f, 0.5f);
+  for (int y = 0; y < 150; ++y)
+    for (int x = 0; x < 300; ++x) cloud.push_back(float(x), float(y), x < 150 ? 0.0f : noise(rng));
+  ASSERT_GT(cloud.size(), kNoiseGatePoints);
+  const Model gated = constant_model(1).with_gate(GateKind::noise, constant_model(0), 0.1f);
+  std::vector<std::uint8_t> every(cloud.size(), gate_read_bit(GateKind::noise));
+  std::vector<std::uint8_t> sample(cloud.size(), 0);
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (gate_reads(GateKind::noise, i, cloud.size())) sample[i] = gate_read_bit(GateKind::noise);
+  const GateTally whole = gate_tallies(cloud, gated, every)[0];
+  const GateTally sampled = gate_tallies(cloud, gated, sample)[0];
+  EXPECT_EQ(whole.points(), cloud.size());
+  EXPECT_LT(sampled.points(), cloud.size());
+  EXPECT_NEAR(whole.statistic(), 0.5, 0.05);
+  EXPECT_NEAR(sampled.statistic(), whole.statistic(), 0.02);
+  // The statistic is the features': the same values as noise_statistic of each row.
+  const std::vector<float> rows = statistics(cloud);
+  GateTally from_rows = gated.new_tally();
+  for (const float value : rows) from_rows.add(value);
+  EXPECT_EQ(from_rows.counts(), GateTally(whole).counts());
+  // Masks that do not fit the cloud, and a model without a gate, are refused.
+  EXPECT_THROW(gate_tallies(cloud, gated, std::vector<std::uint8_t>(10, 1)), Error);
+  EXPECT_THROW(gate_tallies(cloud, constant_model(1), every), Error);
+}
+
+// A network with random weights, so that its answers depend on every input.
+Model random_network(std::uint64_t seed, bool area_weights) {
+  ModelConfig config;
+  config.area_weights = area_weights;
+  Model model(config);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<float> weight(0.0f, 0.5f);
+  for (DenseLayer& layer : model.layers) {
+    for (float& w : layer.weights) w = weight(rng);
+    for (float& b : layer.bias) b = weight(rng);
+  }
+  return model;
+}
+
+// A 30 x 30 plane of unit spacing, and with `rows` dense rows (0.1 apart along x) across it,
+// as a tessellation's vertices crowd along a feature curve; displaced along z by Gaussian noise
+// of `sigma` spacings.
+PointCloud plane_with_dense_rows(int rows, float sigma = 0.0f) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<float> noise(0.0f, std::max(sigma, 1e-6f));
+  auto z = [&] { return sigma > 0 ? noise(rng) : 0.0f; };
+  PointCloud cloud;
+  for (int y = 0; y < 30; ++y)
+    for (int x = 0; x < 30; ++x) cloud.push_back(float(x), float(y), z());
+  for (int row = 0; row < rows; ++row)
+    for (int i = 0; i < 290; ++i) cloud.push_back(0.1f * float(i), 14.4f + 0.1f * float(row), z());
+  return cloud;
+}
+
+// A sampling gate passes mesh-vertex clouds on to a noise-gated network: each cloud gets one of
+// three networks, and the area-weighted one runs on area-weighted features.
+TEST(GateChain, EachCloudGetsOneNetworkOfTheChain) {
+  const Model clean_network = random_network(3, true);
+  const Model mesh_vertex = constant_model(0).with_gate(GateKind::noise, clean_network, 0.1f);
+  const Model chain = constant_model(1).with_gate(GateKind::sampling, mesh_vertex, 0.98f);
+  ASSERT_EQ(chain.gate_chain().size(), 2u);
+
+  const PointCloud even = plane_with_dense_rows(0), clean = plane_with_dense_rows(3);
+  const PointCloud noisy = plane_with_dense_rows(3, 0.3f);
+  const Classification on_even = classify(even, chain);
+  EXPECT_EQ(network_name(on_even.gates), "default");  // the second gate is not asked
+  EXPECT_EQ(on_even.labels, std::vector<std::uint8_t>(even.size(), 1));
+  const Classification on_noisy = classify(noisy, chain);
+  EXPECT_EQ(network_name(on_noisy.gates), "mesh-vertex/noisy");
+  EXPECT_EQ(on_noisy.labels, std::vector<std::uint8_t>(noisy.size(), 0));
+
+  const Classification on_clean = classify(clean, chain);
+  ASSERT_EQ(network_name(on_clean.gates), "mesh-vertex/low-noise");
+  EXPECT_EQ(&chain.answering_network(on_clean.gates), chain.gate_network->gate_network.get());
+  const Classification alone = classify_ungated(clean, clean_network);
+  EXPECT_EQ(on_clean.labels, alone.labels);
+  EXPECT_EQ(on_clean.p_sharp, alone.p_sharp);
+  // The same weights on counted neighbours answer otherwise: the area weights were used.
+  Model counting = clean_network;
+  counting.config.area_weights = false;
+  EXPECT_NE(classify_ungated(clean, counting).p_sharp, alone.p_sharp);
+
+  // Decisions that do not fit the chain are refused.
+  EXPECT_THROW(chain.answering_network({{GateKind::noise, 0.1f, 1.0, true}}), Error);
 }
 
 // ln r8 spread evenly over [0, 1) in 100 points: P10 and P90 within a bin of 0.1 and 0.9.
@@ -154,17 +233,6 @@ TEST(SamplingGate, SpreadIsTheNinetiethLessTheTenthPercentileOfLnSpacing) {
   EXPECT_FALSE(GateTally(GateKind::sampling, 0.5f).gate_network_answers());  // no points
 }
 
-// A 30 x 30 plane of unit spacing, and with `rows` dense rows (0.1 apart along x) across it,
-// as a tessellation's vertices crowd along a feature curve.
-PointCloud plane_with_dense_rows(int rows) {
-  PointCloud cloud;
-  for (int y = 0; y < 30; ++y)
-    for (int x = 0; x < 30; ++x) cloud.push_back(float(x), float(y), 0.0f);
-  for (int row = 0; row < rows; ++row)
-    for (int i = 0; i < 290; ++i) cloud.push_back(0.1f * float(i), 14.4f + 0.1f * float(row), 0.0f);
-  return cloud;
-}
-
 TEST(SamplingGate, ChoosesTheMeshVertexNetworkOnlyForUnevenSpacing) {
   const Model gated = constant_model(1).with_gate(GateKind::sampling, constant_model(0), 0.98f);
   const PointCloud even = plane_with_dense_rows(0), uneven = plane_with_dense_rows(3);
@@ -172,27 +240,28 @@ TEST(SamplingGate, ChoosesTheMeshVertexNetworkOnlyForUnevenSpacing) {
   const Classification grid = classify(even, gated);
   expect_answered_by(grid, false, even.size());
   // Inside, the 8th nearest is a diagonal neighbour (sqrt 2); along the border up to 2 apart.
-  EXPECT_NEAR(grid.gate_statistic, std::log(2.0 / std::sqrt(2.0)), 1.0 / GateTally::kBinsPerUnit);
+  EXPECT_NEAR(grid.gates[0].statistic, std::log(2.0 / std::sqrt(2.0)),
+              1.0 / GateTally::kBinsPerUnit);
   // About half the points 0.1 apart, half 1 apart: ln(P90 / P10) near ln 10.
   const Classification rows = classify(uneven, gated);
   expect_answered_by(rows, true, uneven.size());
-  EXPECT_GT(rows.gate_statistic, 1.5);
-
-  for (const PointCloud* cloud : {&even, &uneven}) expect_apart_as_fused(*cloud, gated);
-  FeatureMatrix without_spacings = compute_features(uneven);
-  without_spacings.squared_spacings.clear();
-  EXPECT_THROW(classify_features(without_spacings, gated), Error);
+  EXPECT_GT(rows.gates[0].statistic, 1.5);
+  EXPECT_EQ(network_name(rows.gates), "mesh-vertex");
 }
 
-TEST(SamplingGate, ReadsEveryPointOfASmallCloudAndAboutAFixedNumberOfALargeOne) {
-  for (std::uint64_t i = 0; i < kSamplingGatePoints; ++i)
-    ASSERT_TRUE(sampling_gate_reads(i, kSamplingGatePoints));
-  for (const std::uint64_t points : {kSamplingGatePoints + 1, 8 * kSamplingGatePoints}) {
-    std::uint64_t read = 0;
-    for (std::uint64_t i = 0; i < points; ++i) read += sampling_gate_reads(i, points);
-    // A binomial count: its standard deviation is below 400.
-    EXPECT_NEAR(double(read), double(kSamplingGatePoints), 2000.0) << points << " points";
+TEST(GateSample, ReadsEveryPointOfASmallCloudAndAboutAFixedNumberOfALargeOne) {
+  for (const GateKind kind : {GateKind::noise, GateKind::sampling}) {
+    const std::uint64_t size = gate_sample_size(kind);
+    for (std::uint64_t i = 0; i < size; ++i) ASSERT_TRUE(gate_reads(kind, i, size));
+    for (const std::uint64_t points : {size + 1, 8 * size}) {
+      std::uint64_t read = 0;
+      for (std::uint64_t i = 0; i < points; ++i) read += gate_reads(kind, i, points);
+      // A binomial count: its standard deviation is below sqrt(size).
+      EXPECT_NEAR(double(read), double(size), 5.0 * std::sqrt(double(size))) << points;
+    }
   }
+  EXPECT_EQ(kNoiseGatePoints, std::uint64_t(1) << 14);
+  EXPECT_EQ(kSamplingGatePoints, std::uint64_t(1) << 17);
 }
 
 TEST(SamplingGate, ALargeCloudsSampleSpreadsAsTheWholeCloud) {
@@ -206,16 +275,19 @@ TEST(SamplingGate, ALargeCloudsSampleSpreadsAsTheWholeCloud) {
       cloud.push_back(0.01f * float(i), 200.4f + 0.1f * float(row), 0.0f);
   ASSERT_GT(cloud.size(), kSamplingGatePoints);
   const Model gated = constant_model(1).with_gate(GateKind::sampling, constant_model(0), 0.98f);
-  std::vector<std::uint8_t> every(cloud.size(), 1), sample(cloud.size());
+  const std::uint8_t bit = gate_read_bit(GateKind::sampling);
+  std::vector<std::uint8_t> every(cloud.size(), bit), sample(cloud.size(), 0);
   for (std::size_t i = 0; i < cloud.size(); ++i)
-    sample[i] = sampling_gate_reads(i, cloud.size()) ? 1 : 0;
-  const GateTally whole = sampling_gate_tally(cloud, gated, every);
-  const GateTally sampled = sampling_gate_tally(cloud, gated, sample);
+    if (gate_reads(GateKind::sampling, i, cloud.size())) sample[i] = bit;
+  const GateTally whole = gate_tallies(cloud, gated, every)[0];
+  const GateTally sampled = gate_tallies(cloud, gated, sample)[0];
   EXPECT_EQ(whole.points(), cloud.size());
   EXPECT_LT(sampled.points(), cloud.size());
   EXPECT_NEAR(sampled.statistic(), whole.statistic(), 2.0 / GateTally::kBinsPerUnit);
   EXPECT_EQ(sampled.gate_network_answers(), whole.gate_network_answers());
-  EXPECT_THROW(sampling_gate_tally(cloud, constant_model(1), every), Error);
+  // Points read by a noise gate only are not a sampling gate's.
+  const std::vector<std::uint8_t> noise_only(cloud.size(), gate_read_bit(GateKind::noise));
+  EXPECT_EQ(gate_tallies(cloud, gated, noise_only)[0].points(), 0u);
 
   GateTally merged = gated.new_tally();
   merged.merge(sampled);
@@ -260,6 +332,23 @@ TEST_F(GateFile, RoundTripIsExact) {
   EXPECT_EQ(sampling.to_json(), by_sampling.to_json());
   EXPECT_TRUE(sampling.to_json().contains("sampling_gate"));
   EXPECT_FALSE(sampling.to_json().contains("noise_gate"));
+
+  // A chain: the sampling gate's network holds a noise gate whose network weighs by area.
+  const Model chain = constant_model(1).with_gate(
+      GateKind::sampling,
+      constant_model(2).with_gate(GateKind::noise, random_network(5, true), 0.0125f), 0.98125f);
+  chain.save(path("chain.json"));
+  const Model loaded_chain = Model::load(path("chain.json"));
+  ASSERT_EQ(loaded_chain.gate_chain().size(), 2u);
+  const Model& last = *loaded_chain.gate_network->gate_network;
+  EXPECT_TRUE(last.config.area_weights);
+  EXPECT_FALSE(loaded_chain.gate_network->config.area_weights);
+  EXPECT_EQ(last.layers[0].weights, random_network(5, true).layers[0].weights);
+  EXPECT_EQ(loaded_chain.gate_network->gate_threshold, 0.0125f);
+  EXPECT_EQ(loaded_chain.to_json(), chain.to_json());
+  EXPECT_EQ(chain.to_json()["sampling_gate"]["mesh_vertices"]["noise_gate"]["low_noise"]
+                           ["neighbour_weights"],
+            "area");
 }
 
 }  // namespace

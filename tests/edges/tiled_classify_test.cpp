@@ -192,7 +192,7 @@ TEST_F(TiledClassify, AreaWeightedTilesGiveTheWholeCloudsLabels) {
 }
 
 // A noise-gated model chooses one network for the whole file: in tiles the same one, from the
-// quiet points of every tile's core, as for the cloud at once.
+// quiet points of every tile's core it reads, as for the cloud at once.
 TEST_F(TiledClassify, AGatedModelChoosesOneNetworkForTheWholeFileInTilesToo) {
   const double origin[3] = {0, 0, 0};
   write_scene(path("scene.las"), origin);
@@ -200,7 +200,7 @@ TEST_F(TiledClassify, AGatedModelChoosesOneNetworkForTheWholeFileInTilesToo) {
   low_noise.layers.back().bias[2] += 4.0f;  // a network that calls far more points boundary
   const Model gated = bounded_model().with_gate(GateKind::noise, low_noise, 0.1f);
   const TiledClassifyStats whole = classify_las(path("scene.las"), path("whole.las"), gated);
-  EXPECT_TRUE(whole.gate_network_answered);  // clean shapes on a flat ground
+  EXPECT_TRUE(whole.gates.at(0).gate_network_answered);  // clean shapes on a flat ground
   classify_las(path("scene.las"), path("alone.las"), low_noise);
   const OutputDifference as_alone = compare_outputs(path("whole.las"), path("alone.las"));
   EXPECT_EQ(as_alone.labels, 0u);
@@ -211,8 +211,8 @@ TEST_F(TiledClassify, AGatedModelChoosesOneNetworkForTheWholeFileInTilesToo) {
   const TiledClassifyStats tiled =
       classify_las(path("scene.las"), path("tiled.las"), gated, params);
   EXPECT_TRUE(tiled.tiled);
-  EXPECT_TRUE(tiled.gate_network_answered);
-  EXPECT_NEAR(tiled.gate_statistic, whole.gate_statistic, 0.01);
+  EXPECT_TRUE(tiled.gates.at(0).gate_network_answered);
+  EXPECT_NEAR(tiled.gates.at(0).statistic, whole.gates.at(0).statistic, 0.01);
   const OutputDifference difference = compare_outputs(path("whole.las"), path("tiled.las"));
   EXPECT_TRUE(difference.other_bytes_equal);
   EXPECT_EQ(difference.labels, 0u);
@@ -221,14 +221,15 @@ TEST_F(TiledClassify, AGatedModelChoosesOneNetworkForTheWholeFileInTilesToo) {
   write_scene(path("noisy-scene.las"), origin, 0.1);
   const TiledClassifyStats noisy =
       classify_las(path("noisy-scene.las"), path("noisy.las"), gated, params);
-  EXPECT_FALSE(noisy.gate_network_answered);
+  EXPECT_FALSE(noisy.gates.at(0).gate_network_answered);
   classify_las(path("noisy-scene.las"), path("ungated.las"), bounded_model(), params);
   EXPECT_EQ(compare_outputs(path("noisy.las"), path("ungated.las")).labels, 0u);
   EXPECT_EQ(compare_outputs(path("noisy.las"), path("ungated.las")).probabilities, 0u);
 }
 
-// A sampling gate's spread comes from every tile's core points: the whole file's, in tiles too.
-TEST_F(TiledClassify, ASamplingGateReadsTheWholeFilesSpacingsInTiles) {
+// A sampling gate's spread comes from every tile's core points: the whole file's, in tiles too;
+// so do the decisions of a chain of gates.
+TEST_F(TiledClassify, GatesReadTheWholeFileInTiles) {
   const double origin[3] = {0, 0, 0};
   write_scene(path("scene.las"), origin);
   Model mesh_vertex = bounded_model();
@@ -236,20 +237,35 @@ TEST_F(TiledClassify, ASamplingGateReadsTheWholeFilesSpacingsInTiles) {
   // Thresholds just below and far above the scene's spread: each network answers once.
   const Model probe = bounded_model().with_gate(GateKind::sampling, mesh_vertex, 100.0f);
   const TiledClassifyStats spread = classify_las(path("scene.las"), path("probe.las"), probe);
-  ASSERT_GT(spread.gate_statistic, 0.1);
-  for (const float threshold : {float(spread.gate_statistic) - 0.05f, 100.0f}) {
-    const Model gated = bounded_model().with_gate(GateKind::sampling, mesh_vertex, threshold);
+  ASSERT_GT(spread.gates.at(0).statistic, 0.1);
+  // The scene at once and in tiles: the same network and labels.
+  auto whole_and_tiled = [&](const Model& gated) {
     const TiledClassifyStats whole = classify_las(path("scene.las"), path("whole.las"), gated);
     TiledClassifyParams params;
     params.tile_points = 9000;
     const TiledClassifyStats tiled =
         classify_las(path("scene.las"), path("tiled.las"), gated, params);
     EXPECT_TRUE(tiled.tiled);
-    EXPECT_EQ(whole.gate_network_answered, threshold < 100.0f);
-    EXPECT_EQ(tiled.gate_network_answered, whole.gate_network_answered);
-    EXPECT_NEAR(tiled.gate_statistic, whole.gate_statistic, 1.0 / GateTally::kBinsPerUnit);
+    EXPECT_EQ(network_name(tiled.gates), network_name(whole.gates));
     EXPECT_EQ(compare_outputs(path("whole.las"), path("tiled.las")).labels, 0u);
+    return std::pair{whole, tiled};
+  };
+  for (const float threshold : {float(spread.gates.at(0).statistic) - 0.05f, 100.0f}) {
+    const auto [whole, tiled] =
+        whole_and_tiled(bounded_model().with_gate(GateKind::sampling, mesh_vertex, threshold));
+    EXPECT_EQ(whole.gates.at(0).gate_network_answered, threshold < 100.0f);
+    EXPECT_NEAR(tiled.gates.at(0).statistic, whole.gates.at(0).statistic,
+                1.0 / GateTally::kBinsPerUnit);
   }
+
+  // A chain: the sampling gate passes the file on to a noise gate, in tiles as at once.
+  const auto [whole, tiled] = whole_and_tiled(bounded_model().with_gate(
+      GateKind::sampling, bounded_model().with_gate(GateKind::noise, mesh_vertex, 0.1f),
+      float(spread.gates.at(0).statistic) - 0.05f));
+  EXPECT_EQ(network_name(whole.gates), "mesh-vertex/low-noise");  // clean shapes, flat ground
+  EXPECT_NEAR(tiled.gates.at(1).statistic, whole.gates.at(1).statistic, 0.01);
+  classify_las(path("scene.las"), path("alone.las"), mesh_vertex);
+  EXPECT_EQ(compare_outputs(path("whole.las"), path("alone.las")).probabilities, 0u);
 }
 
 TEST_F(TiledClassify, FarFromTheOriginClassifiesExactlyAsAtTheOrigin) {

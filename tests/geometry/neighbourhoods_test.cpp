@@ -177,6 +177,40 @@ TEST(Neighbourhoods, KthDistancesOfWantedPointsOnly) {
   EXPECT_THROW(search.kth_nearest_squared_distances(9, {}, wanted), glint::Error);
 }
 
+TEST(Neighbourhoods, VisitsWantedPointsOnly) {
+  // Every third point wanted: each visited once, with the neighbour distances of the full pass
+  // (retries and the k-d tree included); a mask of another size is refused.
+  const PointCloud cloud = uneven_cloud();
+  NeighbourhoodParams params;
+  params.k = 64;
+  const NeighbourhoodSearch search(cloud, params);
+  std::vector<std::uint8_t> wanted(cloud.size(), 0);
+  for (std::size_t i = 0; i < cloud.size(); i += 3) wanted[i] = 1;
+  std::vector<std::vector<float>> all(cloud.size()), some(cloud.size());
+  std::vector<std::atomic<int>> visits(cloud.size());
+  auto keep = [](std::vector<std::vector<float>>& lists) {
+    return [&lists](const Neighbourhood& nb) {
+      std::vector<float>& list = lists[nb.point];
+      for (int j = 0; j < nb.size; ++j)
+        list.push_back(nb.dx[j] * nb.dx[j] + nb.dy[j] * nb.dy[j] + nb.dz[j] * nb.dz[j]);
+      std::sort(list.begin(), list.end());
+    };
+  };
+  search.for_each(keep(all));
+  search.for_each(
+      [&](const Neighbourhood& nb) {
+        ++visits[nb.point];
+        keep(some)(nb);
+      },
+      {}, {}, wanted);
+  std::size_t wrong = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    wrong += visits[i] != (wanted[i] ? 1 : 0) || (wanted[i] && some[i] != all[i]);
+  EXPECT_EQ(wrong, 0u);
+  wanted.pop_back();
+  EXPECT_THROW(search.for_each([](const Neighbourhood&) {}, {}, {}, wanted), glint::Error);
+}
+
 TEST(Neighbourhoods, KthDistancesRefuseBadK) {
   PointCloud cloud;
   for (int i = 0; i < 20; ++i) cloud.push_back(float(i), 0.f, 0.f);
