@@ -6,12 +6,13 @@
 # training seeds), bounded-<c>c-gated-s{1,2,3}.json (the noise-gated pairs of the three clean
 # seeds), bounded-3c-area-s{1,2,3}.json (area-weighted neighbourhoods, AREA_WEIGHTS=1),
 # bounded-<c>c-vertices-s{1,2,3}.json (more mesh-vertex clouds, MESH_VERTICES=1),
-# bounded-<c>c-sampling-s{1,2,3}.json (the sampling-gated pairs of the mesh-vertex seeds) and
-# bounded-<c>c-old.json (the models shipped before them) are scored beside
+# bounded-<c>c-sampling-s{1,2,3}.json (the sampling-gated pairs of the mesh-vertex seeds),
+# bounded-3c-chain-s{1,2,3}.json (the pair with a low-noise area-weighted network, the opt-in
+# models/bounded-3c-cad-vertices.json's candidates) and bounded-<c>c-old.json (the models shipped before them) are scored beside
 # the baselines `glint edges eval` prints (CA, and the angle-gap boundary criterion where the
 # build has it).
 # Held-out set: 20 parts of seed 9001, or of $SEED in another WORK (training used seeds 101 and
-# 102, model selection seeds 5001, 5002, 5301 and 5401; the recipe `cylinder` was never trained on),
+# 102, model selection seeds 5001, 5002, 5301, 5401, 5501 and 5601; the recipe `cylinder` was never trained on),
 # each sampled at its mesh vertices and uniformly,
 # clean and with noise 0.25, 0.5 and 1 median spacing along the normal: sharp edges scored on
 # the closed parts, boundaries on the same parts cut open by a random plane. The angle-gap
@@ -35,7 +36,8 @@ models() {  # classes
     "$TRAIN"/models/bounded-"$1"c-gated-s[0-9].json \
     "$TRAIN"/models/bounded-"$1"c-area-s[0-9].json \
     "$TRAIN"/models/bounded-"$1"c-vertices-s[0-9].json \
-    "$TRAIN"/models/bounded-"$1"c-sampling-s[0-9].json; do
+    "$TRAIN"/models/bounded-"$1"c-sampling-s[0-9].json \
+    "$TRAIN"/models/bounded-"$1"c-chain-s[0-9].json; do
     printf -- '--model %s ' "$m"
   done
 }

@@ -27,6 +27,9 @@
 # scripts/select-sampling-gate.py with a network trained on mesh-vertex clouds alone (300 more
 # parts, seed 102), behind the sampling gate, by the rule of models/README.md, "The sampling
 # gate", on decision sets of seed 5301: the shipped 3-class model is such a pair.
+# scripts/select-clean-vertex-gate.py gives the pair's mesh-vertex network a noise gate with an
+# area-weighted low-noise network by the rule of models/README.md, "The low-noise mesh-vertex
+# network": the opt-in models/bounded-3c-cad-vertices.json is that chain.
 set -euo pipefail
 GLINT=${1:-build/release/apps/glint/glint}
 DATA=${2:-${GLINT_DATA:-../shared/data}}
@@ -137,6 +140,16 @@ for seed in $SEEDS; do
   wait
 done
 
+# The low-noise network behind the mesh-vertex network's noise gate: the 3-class mesh-vertex
+# network's data and inputs with neighbours weighed by area (docs/decisions.md "A low-noise
+# area-weighted network for clean mesh-vertex clouds").
+for seed in $SEEDS; do
+  name="bounded-3c-mesh-vertex-area-s$seed"
+  [[ -f "$WORK/models/$name.json" ]] ||
+    train "$name" 3 "$seed" "$MESH_VERTEX_NOTES; area-weighted neighbourhoods" \
+      "${VERTEX_CLOUDS[@]}" "$WORK/cad-vertices" --angular-gap --area-weights
+done
+
 # The CAD validation set of the selection rule (seed 5001: neither trained on nor evaluated).
 [[ -f "$WORK/cad-val/manifest.json" ]] ||
   "${NICE[@]}" "$GLINT" edges synth --kind cad -o "$WORK/cad-val" --count 40 --seed 5001 \
@@ -157,3 +170,18 @@ for opening in closed cut; do
       --max-points 40000
 done
 /usr/bin/python3 "$(dirname "$0")/select-sampling-gate.py" "$GLINT" "$WORK" models "$DATA"
+# The decision sets of the low-noise mesh-vertex network: seed 5501 (as 5301's) and seed 5601
+# (mesh vertices, clean or at 0.25 spacing; the second test of the rule).
+for opening in closed cut; do
+  cut=0 suffix=""
+  [[ $opening == cut ]] && cut=1 suffix="-cut"
+  [[ -f "$WORK/cad-dec2$suffix/manifest.json" ]] ||
+    "${NICE[@]}" "$GLINT" edges synth --kind cad -o "$WORK/cad-dec2$suffix" --count 180 \
+      --seed 5501 --sampling vertices,uniform,scan --noise 0,0.5,1 --plane-cut "$cut" \
+      --min-points 4000 --max-points 40000
+  [[ -f "$WORK/cad-dec3$suffix/manifest.json" ]] ||
+    "${NICE[@]}" "$GLINT" edges synth --kind cad -o "$WORK/cad-dec3$suffix" --count 160 \
+      --seed 5601 --sampling vertices --noise 0,0,0,0.25 --outliers 0 --plane-cut "$cut" \
+      --min-points 4000 --max-points 40000
+done
+/usr/bin/python3 "$(dirname "$0")/select-clean-vertex-gate.py" "$GLINT" "$WORK" models "$DATA"

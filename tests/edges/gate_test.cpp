@@ -295,6 +295,27 @@ TEST(SamplingGate, ALargeCloudsSampleSpreadsAsTheWholeCloud) {
   EXPECT_THROW(merged.merge(GateTally(GateKind::noise, 0.1f)), Error);
 }
 
+// The opt-in models/bounded-3c-cad-vertices.json is the shipped 3-class model with a third
+// network behind a noise gate on its mesh-vertex network: the same answers wherever that gate
+// does not pass a cloud on.
+TEST(ShippedModels, TheCadVertexModelExtendsTheDefaultModel) {
+  const std::string models = std::string(GLINT_TEST_DATA_DIR) + "/../../models/";
+  const Model shipped = Model::load(models + "bounded-3c.json");
+  const Model chain = Model::load(models + "bounded-3c-cad-vertices.json");
+  ASSERT_EQ(shipped.gate_chain().size(), 1u);
+  ASSERT_EQ(chain.gate_chain().size(), 2u);
+  EXPECT_EQ(chain.gate_kind, shipped.gate_kind);
+  EXPECT_EQ(chain.gate_threshold, shipped.gate_threshold);
+  EXPECT_EQ(chain.layers.back().weights, shipped.layers.back().weights);
+  const Model& mesh_vertex = *chain.gate_network;
+  EXPECT_EQ(mesh_vertex.layers.back().weights, shipped.gate_network->layers.back().weights);
+  EXPECT_EQ(mesh_vertex.input_mean, shipped.gate_network->input_mean);
+  EXPECT_EQ(mesh_vertex.gate_kind, GateKind::noise);
+  EXPECT_EQ(mesh_vertex.gate_threshold, 0.01f);
+  EXPECT_TRUE(mesh_vertex.gate_network->config.area_weights);
+  EXPECT_FALSE(mesh_vertex.config.area_weights);
+}
+
 class GateFile : public ::testing::Test {
  protected:
   GateFile()
