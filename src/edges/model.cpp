@@ -369,7 +369,7 @@ void read_gate(const io::JsonFields& reader, const nlohmann::json& object, const
     try {
       model.check();
     } catch (const Error& e) {
-      reader.fail(e.element(), e.reason());
+      reader.fail(io::key_path(where, e.element()), e.reason());
     }
   }
 }

@@ -377,6 +377,31 @@ TEST_F(MalformedModelTest, BrokenGates) {
                   "sampling_gate.threshold", by_sampling);
   expect_rejected([&](nlohmann::json& j) { j["noise_gate"] = gated["noise_gate"]; },
                   "sampling_gate", by_sampling);
+  // A chain: the errors of the inner gate name its whole key path.
+  ModelConfig area;
+  area.area_weights = true;
+  const nlohmann::json chain =
+      random_model(ModelConfig{}, 3)
+          .with_gate(GateKind::sampling,
+                     random_model(ModelConfig{}, 4)
+                         .with_gate(GateKind::noise, random_model(area, 5), 0.01f),
+                     0.98f)
+          .to_json();
+  const std::string inner = "sampling_gate.mesh_vertices.noise_gate";
+  expect_rejected(
+      [](nlohmann::json& j) {
+        j["sampling_gate"]["mesh_vertices"]["noise_gate"]["low_noise"]["neighbour_weights"] =
+            "volume";
+      },
+      inner + ".low_noise.neighbour_weights", chain);
+  expect_rejected(
+      [](nlohmann::json& j) {
+        j["sampling_gate"]["mesh_vertices"]["noise_gate"]["low_noise"]["layers"][0].erase("bias");
+      },
+      inner + ".low_noise.layers[0].bias", chain);
+  expect_rejected(
+      [](nlohmann::json& j) { j["sampling_gate"]["mesh_vertices"]["noise_gate"]["threshold"] = 0; },
+      inner + ".threshold", chain);
 }
 
 TEST_F(MalformedModelTest, NotJsonOrNoFile) {
