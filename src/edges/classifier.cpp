@@ -121,10 +121,6 @@ GateTally tally_of(const PointCloud& cloud, const Model& gated,
   return tally;
 }
 
-GateDecision decision_of(const Model& gated, const GateTally& tally) {
-  return {gated.gate_kind, gated.gate_threshold, tally.statistic(), tally.gate_network_answers()};
-}
-
 // The gate-read masks of a whole cloud for the gates of the model's chain.
 std::vector<std::uint8_t> whole_cloud_reads(const Model& model, std::size_t points) {
   std::vector<std::uint8_t> reads(points, 0);
@@ -176,8 +172,7 @@ Classification classify(const PointCloud& cloud, const Model& model,
   Classification result =
       run_network(cloud, model, chosen_scales, [&](const geometry::NeighbourhoodSearch& search) {
         for (const Model* gated = &model; gated->gated(); gated = gated->gate_network.get()) {
-          decisions.push_back(
-              decision_of(*gated, tally_of(cloud, *gated, search, reads, chosen_scales)));
+          decisions.push_back(tally_of(cloud, *gated, search, reads, chosen_scales).decision());
           if (!decisions.back().gate_network_answered) break;
         }
         return &model.answering_network(decisions);

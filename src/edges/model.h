@@ -77,6 +77,14 @@ enum class GateKind {
   sampling,
 };
 
+// What one gate decided for a cloud (or a file), for logs and reports.
+struct GateDecision {
+  GateKind kind = GateKind::noise;
+  float threshold = 0;
+  double statistic = 0;  // GateTally::statistic
+  bool gate_network_answered = false;
+};
+
 // A gate's evidence summed over the points of a cloud, or over the core points of every tile
 // of a file (counts add across tiles and ranks, so the choice is the whole file's).
 class GateTally {
@@ -98,6 +106,8 @@ class GateTally {
   // percentile the centre of the bin where the sorted points reach it.
   double statistic() const;
   bool gate_network_answers() const;
+  // The statistic and the choice, with the gate's kind and threshold.
+  GateDecision decision() const { return {kind_, threshold_, statistic(), gate_network_answers()}; }
 
  private:
   GateKind kind_;
@@ -118,13 +128,6 @@ inline std::uint64_t gate_sample_size(GateKind kind) {
 }
 bool gate_reads(GateKind kind, std::uint64_t index, std::uint64_t points);
 
-// What one gate decided for a cloud (or a file), for logs and reports.
-struct GateDecision {
-  GateKind kind = GateKind::noise;
-  float threshold = 0;
-  double statistic = 0;  // GateTally::statistic
-  bool gate_network_answered = false;
-};
 // The name of the network that answered after these decisions (first gate first): each
 // decision's "mesh-vertex" or "default" (sampling), "low-noise" or "noisy" (noise), joined by
 // "/"; empty for an ungated model.

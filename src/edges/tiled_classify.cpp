@@ -674,9 +674,7 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
     progress.finish();
     for (std::size_t g = 0; g < tallies.size(); ++g) {
       world.sum(tallies[g].counts());
-      const Model& gated = *gate_chain[g];
-      stats.gates.push_back({gated.gate_kind, gated.gate_threshold, tallies[g].statistic(),
-                             tallies[g].gate_network_answers()});
+      stats.gates.push_back(tallies[g].decision());
       if (!stats.gates.back().gate_network_answered) break;
     }
     network = &model.answering_network(stats.gates);
