@@ -474,7 +474,7 @@ std::vector<float> noise_statistics(const PointCloud& cloud, const FeatureParams
                                     std::span<const std::uint8_t> wanted) {
   check_cloud(cloud, params);
   // The statistic reads the smallest scale alone, whose values depend on its own k nearest
-  // only: a search for that k finds them for a fraction of the largest scale's cost.
+  // only, so a search for that k and a one-scale kernel give it.
   FeatureParams smallest = params;
   smallest.scales = {params.scales.back()};
   const geometry::NeighbourhoodSearch search(cloud, search_params_for(smallest));
