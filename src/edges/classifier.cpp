@@ -123,10 +123,9 @@ GateTally tally_of(const PointCloud& cloud, const Model& gated,
 
 // The gate-read masks of a whole cloud for the gates of the model's chain.
 std::vector<std::uint8_t> whole_cloud_reads(const Model& model, std::size_t points) {
-  std::vector<std::uint8_t> reads(points, 0);
-  for (const Model* gated : model.gate_chain())
-    for (std::size_t i = 0; i < points; ++i)
-      if (gate_reads(gated->gate_kind, i, points)) reads[i] |= gate_read_bit(gated->gate_kind);
+  const std::vector<const Model*> chain = model.gate_chain();
+  std::vector<std::uint8_t> reads(points);
+  for (std::size_t i = 0; i < points; ++i) reads[i] = gate_read_mask(chain, i, points);
   return reads;
 }
 
@@ -140,6 +139,14 @@ geometry::NeighbourhoodParams search_params(const std::vector<int>& scales) {
 }
 
 }  // namespace
+
+std::uint8_t gate_read_mask(std::span<const Model* const> chain, std::uint64_t index,
+                            std::uint64_t points) {
+  std::uint8_t mask = 0;
+  for (const Model* gated : chain)
+    if (gate_reads(gated->gate_kind, index, points)) mask |= gate_read_bit(gated->gate_kind);
+  return mask;
+}
 
 std::vector<GateTally> gate_tallies(const PointCloud& cloud, const Model& model,
                                     std::span<const std::uint8_t> reads,

@@ -44,6 +44,10 @@ Classification classify_ungated(const PointCloud& cloud, const Model& network,
 inline std::uint8_t gate_read_bit(GateKind kind) {
   return kind == GateKind::noise ? std::uint8_t(1) : std::uint8_t(2);
 }
+// The gate-read mask of the point of input index `index` of `points` for the gates of a chain
+// (Model::gate_chain): the bits of the gates that read it (gate_reads).
+std::uint8_t gate_read_mask(std::span<const Model* const> chain, std::uint64_t index,
+                            std::uint64_t points);
 // The tallies of every gate of the model's chain (Model::gate_chain), each over the points of
 // `cloud` whose mask in `reads` (one per point) has its kind's bit, their values as classify()
 // finds them (tiled classification sums the tallies of every tile's core points before it

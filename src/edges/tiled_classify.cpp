@@ -374,13 +374,6 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
   if (params.tile_points > 0) tile_limit = std::min(tile_limit, params.tile_points);
 
   const std::vector<const Model*> gate_chain = model.gate_chain();
-  // The gates that read the point of input index `index` (the same points as in the whole cloud).
-  auto read_mask = [&](std::uint64_t index) {
-    std::uint32_t mask = 0;
-    for (const Model* gated : gate_chain)
-      if (gate_reads(gated->gate_kind, index, n)) mask |= gate_read_bit(gated->gate_kind);
-    return mask;
-  };
   TiledClassifyStats stats;
   stats.points = n;
   stats.points_per_tile_limit = tile_limit;
@@ -543,7 +536,8 @@ TiledClassifyStats classify_las(const std::string& input, const std::string& out
           for (std::size_t j = 0; j < count; ++j) {
             std::int32_t xyz[3];
             io::las_record_xyz(records + j * in_length, xyz);
-            const std::uint32_t reads = read_mask(first + j);
+            // The points the gates read in the whole cloud.
+            const std::uint32_t reads = gate_read_mask(gate_chain, first + j, n);
             const std::int64_t ux = std::int64_t(xyz[0]) - grid.low[0];
             const std::int64_t uy = std::int64_t(xyz[1]) - grid.low[1];
             const std::size_t own = core_tile(xyz);
