@@ -262,7 +262,9 @@ void register_edges_classify(CLI::App& edges) {
       ->check(kOutputFile);
   command->add_option("--model", options->model,
                       "Model JSON (default: the shipped 3-class models/bounded-3c.json; "
-                      "models/bounded-2c.json has no boundary class)");
+                      "models/bounded-2c.json has no boundary class; "
+                      "models/bounded-3c-cad-vertices.json is more accurate and slower on clean "
+                      "CAD tessellations' vertices)");
   command
       ->add_option("--scales", options->scales,
                    "Override the model's neighbourhood sizes, largest first, e.g. 256,128,64,32 "
