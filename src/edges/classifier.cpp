@@ -106,6 +106,10 @@ GateTally tally_of(const PointCloud& cloud, const Model& gated,
   const std::uint8_t bit = gate_read_bit(gated.gate_kind);
   std::vector<std::uint8_t> wanted(reads.size());
   for (std::size_t i = 0; i < reads.size(); ++i) wanted[i] = (reads[i] & bit) ? 1 : 0;
+  GateTally tally = gated.new_tally();
+  // A tile may hold none of the points a gate reads: no pass for it.
+  if (std::none_of(wanted.begin(), wanted.end(), [](std::uint8_t w) { return w != 0; }))
+    return tally;
   std::vector<float> values;
   if (gated.gate_kind == GateKind::sampling) {
     const int k = std::min(kAreaSpacingNeighbour + 1, scales.front());
@@ -115,7 +119,6 @@ GateTally tally_of(const PointCloud& cloud, const Model& gated,
     params.scales = scales;
     values = noise_statistics(cloud, params, wanted);
   }
-  GateTally tally = gated.new_tally();
   for (std::size_t i = 0; i < wanted.size(); ++i)
     if (wanted[i]) tally.add(values[i]);
   return tally;
@@ -127,15 +130,6 @@ std::vector<std::uint8_t> whole_cloud_reads(const Model& model, std::size_t poin
   std::vector<std::uint8_t> reads(points);
   for (std::size_t i = 0; i < points; ++i) reads[i] = gate_read_mask(chain, i, points);
   return reads;
-}
-
-// The search the features build, for a pass of its own.
-geometry::NeighbourhoodParams search_params(const std::vector<int>& scales) {
-  // Cells sized as for the features: a grid sized for a small k sends the queries of sparse
-  // parts to a k-d tree built for them alone.
-  geometry::NeighbourhoodParams params;
-  params.k = scales.front();
-  return params;
 }
 
 }  // namespace
@@ -155,7 +149,9 @@ std::vector<GateTally> gate_tallies(const PointCloud& cloud, const Model& model,
   if (reads.size() != cloud.size())
     throw Error("", "gate", fmt::format("{} read masks for {} points", reads.size(), cloud.size()));
   const std::vector<int> chosen_scales = scales_for(model, scales);
-  const geometry::NeighbourhoodSearch search(cloud, search_params(chosen_scales));
+  // Cells sized as for the features: a grid sized for the sampling gate's small k sends the
+  // queries of sparse parts to a k-d tree built for them alone.
+  const geometry::NeighbourhoodSearch search(cloud, feature_search_params(chosen_scales));
   std::vector<GateTally> tallies;
   for (const Model* gated : model.gate_chain())
     tallies.push_back(tally_of(cloud, *gated, search, reads, chosen_scales));
@@ -178,11 +174,14 @@ Classification classify(const PointCloud& cloud, const Model& model,
   std::vector<GateDecision> decisions;
   Classification result =
       run_network(cloud, model, chosen_scales, [&](const geometry::NeighbourhoodSearch& search) {
-        for (const Model* gated = &model; gated->gated(); gated = gated->gate_network.get()) {
-          decisions.push_back(tally_of(cloud, *gated, search, reads, chosen_scales).decision());
+        // Each gate passes the cloud on or keeps it for its own network.
+        const Model* network = &model;
+        while (network->gated()) {
+          decisions.push_back(tally_of(cloud, *network, search, reads, chosen_scales).decision());
           if (!decisions.back().gate_network_answered) break;
+          network = network->gate_network.get();
         }
-        return &model.answering_network(decisions);
+        return network;
       });
   result.gates = std::move(decisions);
   return result;

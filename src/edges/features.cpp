@@ -357,6 +357,12 @@ PointKernel point_kernel() {
 
 }  // namespace
 
+geometry::NeighbourhoodParams feature_search_params(const std::vector<int>& scales) {
+  geometry::NeighbourhoodParams params;
+  params.k = scales.front();
+  return params;
+}
+
 float noise_statistic(const float* row, int scales, int per_scale) {
   const float* smallest = row + (scales - 1) * per_scale;
   // Rounding can leave a flat subset's smallest eigenvalue slightly negative.
@@ -413,13 +419,6 @@ std::vector<float> squared_spacings(const PointCloud& cloud,
   return search.kth_nearest_squared_distances(k, [&](std::size_t done) { progress.advance(done); });
 }
 
-// The neighbour search of the features: built for the largest scale.
-geometry::NeighbourhoodParams search_params_for(const FeatureParams& params) {
-  geometry::NeighbourhoodParams search_params;
-  search_params.k = params.scales[0];
-  return search_params;
-}
-
 // Every point's features, written to row_for(point, scratch); row_written(scratch) follows
 // on the same thread. search_ready as in compute_features_in_blocks. The cloud must have passed
 // check_cloud.
@@ -428,7 +427,7 @@ void compute_rows(const PointCloud& cloud, const FeatureParams& given_params,
                   tbb::enumerable_thread_specific<Scratch>& scratches, RowFor&& row_for,
                   RowWritten&& row_written, const SearchReady& search_ready) {
   const PointKernel kernel = point_kernel();
-  const geometry::NeighbourhoodSearch search(cloud, search_params_for(given_params));
+  const geometry::NeighbourhoodSearch search(cloud, feature_search_params(given_params.scales));
   FeatureParams params = given_params;
   if (search_ready) {
     params = search_ready(search);
@@ -477,7 +476,7 @@ std::vector<float> noise_statistics(const PointCloud& cloud, const FeatureParams
   // only, so a search for that k and a one-scale kernel give it.
   FeatureParams smallest = params;
   smallest.scales = {params.scales.back()};
-  const geometry::NeighbourhoodSearch search(cloud, search_params_for(smallest));
+  const geometry::NeighbourhoodSearch search(cloud, feature_search_params(smallest.scales));
   const PointKernel kernel = point_kernel();
   const std::vector<float> spacings =
       params.area_weights ? squared_spacings(cloud, search) : std::vector<float>();

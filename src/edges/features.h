@@ -41,7 +41,8 @@
 
 namespace glint::geometry {
 class NeighbourhoodSearch;
-}
+struct NeighbourhoodParams;
+}  // namespace glint::geometry
 
 namespace glint::edges {
 
@@ -104,6 +105,9 @@ using SearchReady = std::function<FeatureParams(const geometry::NeighbourhoodSea
 void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& params,
                                 std::size_t block_size, const FeatureBlockConsumer& consume,
                                 const SearchReady& search_ready = {});
+
+// The neighbour search the features build: exact neighbourhoods of the largest scale.
+geometry::NeighbourhoodParams feature_search_params(const std::vector<int>& scales);
 
 // The noise statistic of one point, from its feature row (`scales` scales of `per_scale`
 // values each): at the smallest scale, sqrt(sigma_upper(3) + sigma_lower(3)), the spread of
