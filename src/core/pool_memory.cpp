@@ -27,13 +27,15 @@ void* detail::map_pool(std::size_t count, std::size_t element_bytes, const char*
                  "cannot reserve " + std::to_string(count) + " elements of " +
                      std::to_string(element_bytes) + " bytes: " + why);
   };
-  if (count > (std::numeric_limits<std::size_t>::max() - kHugePage) / element_bytes)
+  if (count > (std::numeric_limits<std::size_t>::max() - 2 * kHugePage) / element_bytes)
     throw cannot_reserve("larger than the address space");
   const std::size_t bytes = count * element_bytes;
-  // Huge pages back only 2 MiB-aligned stretches, so large pools reserve one huge page more and
-  // start at the first aligned address.
+  // Huge pages back only whole 2 MiB-aligned stretches of the advised range, so large pools
+  // reserve whole huge pages and one more, start at the first aligned address and advise up to
+  // the last whole page (a pool's tail on 4 KiB pages faults once per page on first touch).
   const bool huge = bytes >= kHugePage;
-  const std::size_t mapped_bytes = huge ? bytes + kHugePage : bytes;
+  const std::size_t huge_bytes = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+  const std::size_t mapped_bytes = huge ? huge_bytes + kHugePage : bytes;
   void* mapping = mmap(nullptr, mapped_bytes, PROT_READ | PROT_WRITE,
                        MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
   if (mapping == MAP_FAILED) throw cannot_reserve(std::strerror(errno));
@@ -42,7 +44,7 @@ void* detail::map_pool(std::size_t count, std::size_t element_bytes, const char*
   const auto start = (reinterpret_cast<std::uintptr_t>(mapping) + kHugePage - 1) & ~(kHugePage - 1);
   void* array = reinterpret_cast<void*>(start);
 #if defined(MADV_HUGEPAGE)
-  madvise(array, bytes, MADV_HUGEPAGE);
+  madvise(array, huge_bytes, MADV_HUGEPAGE);
 #endif
   return array;
 }

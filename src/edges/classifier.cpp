@@ -40,8 +40,10 @@ std::vector<int> scales_for(const Model& model, const std::vector<int>& scales) 
 }
 
 // The network a pass runs, chosen once the cloud's neighbour search is built and before any
-// row (a gate chooses from what the search finds).
-using NetworkChoice = std::function<const Model*(const geometry::NeighbourhoodSearch&)>;
+// row (a gate chooses from what the search finds, and leaves in the findings what the rows
+// reuse).
+using NetworkChoice =
+    std::function<const Model*(const geometry::NeighbourhoodSearch&, SearchFindings&)>;
 
 // Computes the features at the chosen network's inputs and runs it on each block of them as it
 // is computed, so the rows are never all stored. `model` gives the scale count and the classes
@@ -81,8 +83,8 @@ Classification run_network(const PointCloud& cloud, const Model& model,
         }
         worker.network_s += network_watch.elapsed_s();
       },
-      [&](const geometry::NeighbourhoodSearch& search) {
-        network = choose(search);
+      [&](const geometry::NeighbourhoodSearch& search, SearchFindings& findings) {
+        network = choose(search, findings);
         result = sized_result(cloud.size());
         FeatureParams chosen = network->config.feature_params();
         chosen.scales = scales;
@@ -98,11 +100,12 @@ Classification run_network(const PointCloud& cloud, const Model& model,
 }
 
 // The tally of the gate `gated` holds over the points whose mask in `reads` has its kind's bit:
-// their spacing to the kAreaSpacingNeighbour-th nearest other point, found with `search` (built
-// for the largest scale), or their noise statistic at `gated`'s own inputs.
+// their spacing to the kAreaSpacingNeighbour-th nearest other point, found with `search` (the
+// features' search), or their noise statistic at `gated`'s own inputs. With `findings`, what the
+// rows can reuse is left there: the spacings, and the lists the noise statistic read.
 GateTally tally_of(const PointCloud& cloud, const Model& gated,
                    const geometry::NeighbourhoodSearch& search, std::span<const std::uint8_t> reads,
-                   const std::vector<int>& scales) {
+                   const std::vector<int>& scales, SearchFindings* findings) {
   const std::uint8_t bit = gate_read_bit(gated.gate_kind);
   std::vector<std::uint8_t> wanted(reads.size());
   for (std::size_t i = 0; i < reads.size(); ++i) wanted[i] = (reads[i] & bit) ? 1 : 0;
@@ -111,16 +114,22 @@ GateTally tally_of(const PointCloud& cloud, const Model& gated,
   if (std::none_of(wanted.begin(), wanted.end(), [](std::uint8_t w) { return w != 0; }))
     return tally;
   std::vector<float> values;
+  const int spacing_k = std::min(kAreaSpacingNeighbour + 1, scales.front());
   if (gated.gate_kind == GateKind::sampling) {
-    const int k = std::min(kAreaSpacingNeighbour + 1, scales.front());
-    values = search.kth_nearest_squared_distances(k, {}, wanted);
+    values = search.kth_nearest_squared_distances(spacing_k, {}, wanted);
   } else {
     FeatureParams params = gated.config.feature_params();
     params.scales = scales;
-    values = noise_statistics(cloud, params, wanted);
+    values = noise_statistics(cloud, params, search, wanted, findings);
   }
   for (std::size_t i = 0; i < wanted.size(); ++i)
     if (wanted[i]) tally.add(values[i]);
+  // Handed over, not copied: a large cloud's spacings are megabytes of fresh pages.
+  if (findings && gated.gate_kind == GateKind::sampling &&
+      spacing_k == area_spacing_neighbours(cloud.size())) {
+    findings->spacings = std::move(values);
+    findings->spaced = std::move(wanted);
+  }
   return tally;
 }
 
@@ -154,15 +163,16 @@ std::vector<GateTally> gate_tallies(const PointCloud& cloud, const Model& model,
   const geometry::NeighbourhoodSearch search(cloud, feature_search_params(chosen_scales));
   std::vector<GateTally> tallies;
   for (const Model* gated : model.gate_chain())
-    tallies.push_back(tally_of(cloud, *gated, search, reads, chosen_scales));
+    tallies.push_back(tally_of(cloud, *gated, search, reads, chosen_scales, nullptr));
   return tallies;
 }
 
 Classification classify_ungated(const PointCloud& cloud, const Model& network,
                                 const std::vector<int>& scales) {
   network.check();
-  return run_network(cloud, network, scales_for(network, scales),
-                     [&](const geometry::NeighbourhoodSearch&) { return &network; });
+  return run_network(
+      cloud, network, scales_for(network, scales),
+      [&](const geometry::NeighbourhoodSearch&, SearchFindings&) { return &network; });
 }
 
 Classification classify(const PointCloud& cloud, const Model& model,
@@ -172,12 +182,14 @@ Classification classify(const PointCloud& cloud, const Model& model,
   const std::vector<int> chosen_scales = scales_for(model, scales);
   const std::vector<std::uint8_t> reads = whole_cloud_reads(model, cloud.size());
   std::vector<GateDecision> decisions;
-  Classification result =
-      run_network(cloud, model, chosen_scales, [&](const geometry::NeighbourhoodSearch& search) {
+  Classification result = run_network(
+      cloud, model, chosen_scales,
+      [&](const geometry::NeighbourhoodSearch& search, SearchFindings& findings) {
         // Each gate passes the cloud on or keeps it for its own network.
         const Model* network = &model;
         while (network->gated()) {
-          decisions.push_back(tally_of(cloud, *network, search, reads, chosen_scales).decision());
+          decisions.push_back(
+              tally_of(cloud, *network, search, reads, chosen_scales, &findings).decision());
           if (!decisions.back().gate_network_answered) break;
           network = network->gate_network.get();
         }

@@ -357,6 +357,11 @@ PointKernel point_kernel() {
 
 }  // namespace
 
+int area_spacing_neighbours(std::size_t cloud_points) {
+  return static_cast<int>(
+      std::min(cloud_points, static_cast<std::size_t>(kAreaSpacingNeighbour + 1)));
+}
+
 geometry::NeighbourhoodParams feature_search_params(const std::vector<int>& scales) {
   geometry::NeighbourhoodParams params;
   params.k = scales.front();
@@ -410,13 +415,26 @@ void check_cloud(const PointCloud& cloud, const FeatureParams& params) {
 }
 
 // Every point's squared distance to its kAreaSpacingNeighbour-th nearest other point (or the
-// farthest, in a smaller cloud): the area it stands for, up to a constant.
+// farthest, in a smaller cloud): the area it stands for, up to a constant. Those a choice before
+// the rows found are taken from `findings`.
 std::vector<float> squared_spacings(const PointCloud& cloud,
-                                    const geometry::NeighbourhoodSearch& search) {
-  const int k =
-      static_cast<int>(std::min(cloud.size(), static_cast<std::size_t>(kAreaSpacingNeighbour + 1)));
+                                    const geometry::NeighbourhoodSearch& search,
+                                    const SearchFindings& findings) {
+  const std::span<const std::uint8_t> spaced = findings.spaced;
+  std::vector<std::uint8_t> missing;
+  if (!spaced.empty()) {
+    missing.resize(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) missing[i] = spaced[i] ? 0 : 1;
+    if (std::none_of(missing.begin(), missing.end(), [](std::uint8_t m) { return m != 0; }))
+      return findings.spacings;
+  }
   ProgressBar progress("spacings", cloud.size());
-  return search.kth_nearest_squared_distances(k, [&](std::size_t done) { progress.advance(done); });
+  std::vector<float> spacings = search.kth_nearest_squared_distances(
+      area_spacing_neighbours(cloud.size()), [&](std::size_t done) { progress.advance(done); },
+      missing);
+  for (std::size_t i = 0; i < spaced.size(); ++i)
+    if (spaced[i]) spacings[i] = findings.spacings[i];
+  return spacings;
 }
 
 // Every point's features, written to row_for(point, scratch); row_written(scratch) follows
@@ -429,8 +447,9 @@ void compute_rows(const PointCloud& cloud, const FeatureParams& given_params,
   const PointKernel kernel = point_kernel();
   const geometry::NeighbourhoodSearch search(cloud, feature_search_params(given_params.scales));
   FeatureParams params = given_params;
+  SearchFindings findings;
   if (search_ready) {
-    params = search_ready(search);
+    params = search_ready(search, findings);
     FeatureParams same_rows = params;
     same_rows.area_weights = given_params.area_weights;
     if (same_rows != given_params)
@@ -438,19 +457,28 @@ void compute_rows(const PointCloud& cloud, const FeatureParams& given_params,
   }
   // Handed out per neighbour with the positions, where the kernel weighs by them.
   const std::vector<float> spacings =
-      params.area_weights ? squared_spacings(cloud, search) : std::vector<float>();
+      params.area_weights ? squared_spacings(cloud, search, findings) : std::vector<float>();
+  // The points whose lists the choice kept are visited from those lists, not searched again.
+  const geometry::KeptNeighbourhoods& kept = findings.neighbourhoods;
+  std::vector<std::uint8_t> unlisted;
+  if (!kept.points.empty()) {
+    unlisted.assign(cloud.size(), 1);
+    for (const std::uint32_t point : kept.points) unlisted[point] = 0;
+  }
   ProgressBar progress("features", cloud.size());
-  const geometry::NeighbourhoodStats stats = search.for_each(
-      [&](const geometry::Neighbourhood& nb) {
-        Scratch& scratch = scratches.local();
-        kernel(nb, params, scratch, row_for(nb.point, scratch));
-        row_written(scratch);
-      },
-      [&](std::size_t done) { progress.advance(done); }, spacings);
+  const auto visit = [&](const geometry::Neighbourhood& nb) {
+    Scratch& scratch = scratches.local();
+    kernel(nb, params, scratch, row_for(nb.point, scratch));
+    row_written(scratch);
+  };
+  const auto advance = [&](std::size_t done) { progress.advance(done); };
+  const geometry::NeighbourhoodStats stats = search.for_each(visit, advance, spacings, unlisted);
+  geometry::visit_kept(cloud, kept, visit, advance, spacings);
   log().debug(
-      "neighbourhoods: {} points, {} grid cells of {:.4g}, {} queries retried on a larger "
-      "block, {} answered by the k-d tree",
-      cloud.size(), stats.cells, stats.cell_size, stats.retried_queries, stats.fallback_queries);
+      "neighbourhoods: {} points ({} from kept lists), {} grid cells of {:.4g}, {} queries "
+      "retried on a larger block, {} answered by the k-d tree",
+      cloud.size(), kept.points.size(), stats.cells, stats.cell_size, stats.retried_queries,
+      stats.fallback_queries);
 }
 
 }  // namespace
@@ -470,16 +498,28 @@ FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& par
 }
 
 std::vector<float> noise_statistics(const PointCloud& cloud, const FeatureParams& params,
-                                    std::span<const std::uint8_t> wanted) {
+                                    const geometry::NeighbourhoodSearch& search,
+                                    std::span<const std::uint8_t> wanted,
+                                    SearchFindings* findings) {
   check_cloud(cloud, params);
-  // The statistic reads the smallest scale alone, whose values depend on its own k nearest
-  // only, so a search for that k and a one-scale kernel give it.
+  if (wanted.size() != cloud.size())
+    throw Error("", "noise statistic",
+                fmt::format("{} wanted entries for {} points", wanted.size(), cloud.size()));
+  if (search.k() != params.scales.front())
+    throw Error("", "noise statistic",
+                fmt::format("needs the features' search (k = {}); got k = {}",
+                            params.scales.front(), search.k()));
+  // The lists are nearest first, so the smallest scale's features come from their first k alone:
+  // a one-scale kernel on them gives the values the full rows hold.
   FeatureParams smallest = params;
   smallest.scales = {params.scales.back()};
-  const geometry::NeighbourhoodSearch search(cloud, feature_search_params(smallest.scales));
   const PointKernel kernel = point_kernel();
+  const SearchFindings none;
   const std::vector<float> spacings =
-      params.area_weights ? squared_spacings(cloud, search) : std::vector<float>();
+      params.area_weights ? squared_spacings(cloud, search, findings ? *findings : none)
+                          : std::vector<float>();
+  geometry::KeptNeighbourhoods kept;
+  if (findings) kept = geometry::KeptNeighbourhoods(wanted, search.k());
   std::vector<float> statistics(cloud.size(), 0.0f);
   tbb::enumerable_thread_specific<Scratch> scratches([&] {
     Scratch scratch;
@@ -491,8 +531,16 @@ std::vector<float> noise_statistics(const PointCloud& cloud, const FeatureParams
         Scratch& scratch = scratches.local();
         kernel(nb, smallest, scratch, scratch.block_rows.data());
         statistics[nb.point] = noise_statistic(scratch.block_rows.data(), 1, smallest.per_scale());
+        if (findings) kept.keep(nb);
       },
       {}, spacings, wanted);
+  if (findings) {
+    findings->neighbourhoods = std::move(kept);
+    if (params.area_weights) {
+      findings->spacings = spacings;
+      findings->spaced.assign(cloud.size(), 1);
+    }
+  }
   return statistics;
 }
 

@@ -38,11 +38,7 @@
 #include <vector>
 
 #include "core/point_cloud.h"
-
-namespace glint::geometry {
-class NeighbourhoodSearch;
-struct NeighbourhoodParams;
-}  // namespace glint::geometry
+#include "geometry/neighbourhoods.h"
 
 namespace glint::edges {
 
@@ -91,20 +87,36 @@ struct FeatureMatrix {
 // Runs in parallel (TBB) and shows a progress bar on a terminal.
 FeatureMatrix compute_features(const PointCloud& cloud, const FeatureParams& params = {});
 
+// What a choice made on the features' search before the rows found there, so that the rows do
+// not search for it again: neighbour lists of the largest scale, and area-weight spacings.
+struct SearchFindings {
+  geometry::KeptNeighbourhoods neighbourhoods;
+  // Squared spacings (as area_spacing_neighbours gives them) of the points `spaced` marks, one
+  // entry per point; both empty when none were found.
+  std::vector<float> spacings;
+  std::vector<std::uint8_t> spaced;
+};
+
 // The same features handed over in blocks as they are computed, never all stored (a 1M-point
 // cloud's rows are 192 MB): consume(points, rows, count) gets up to block_size point indices
 // and their rows (row-major, scales·per_scale floats each), from several threads at once; every
 // point comes in exactly one block. Same checks and errors as compute_features.
-// search_ready(search), when given, is called once before the first row with the cloud's
-// neighbour search (its largest k is the largest scale): a choice that depends on the whole
-// cloud, such as a gate's, is made there, before any row is handed to `consume`. It returns the
-// params of the rows: `params` with other neighbour weights at most (glint::Error otherwise).
+// search_ready(search, findings), when given, is called once before the first row with the
+// cloud's neighbour search (its k is the largest scale): a choice that depends on the whole
+// cloud, such as a gate's, is made there, before any row is handed to `consume`, and what it
+// finds on the search may be left in `findings` for the rows. It returns the params of the rows:
+// `params` with other neighbour weights at most (glint::Error otherwise).
 using FeatureBlockConsumer =
     std::function<void(const std::uint32_t* points, const float* rows, std::size_t count)>;
-using SearchReady = std::function<FeatureParams(const geometry::NeighbourhoodSearch& search)>;
+using SearchReady = std::function<FeatureParams(const geometry::NeighbourhoodSearch& search,
+                                                SearchFindings& findings)>;
 void compute_features_in_blocks(const PointCloud& cloud, const FeatureParams& params,
                                 std::size_t block_size, const FeatureBlockConsumer& consume,
                                 const SearchReady& search_ready = {});
+
+// The k whose k-th nearest point (itself first) gives a point's area-weight spacing in a cloud
+// of this many points: the kAreaSpacingNeighbour-th nearest other point, or the farthest.
+int area_spacing_neighbours(std::size_t cloud_points);
 
 // The neighbour search the features build: exact neighbourhoods of the largest scale.
 geometry::NeighbourhoodParams feature_search_params(const std::vector<int>& scales);
@@ -117,11 +129,14 @@ geometry::NeighbourhoodParams feature_search_params(const std::vector<int>& scal
 float noise_statistic(const float* row, int scales, int per_scale);
 
 // noise_statistic of the points `wanted` marks (one entry per point; 0 elsewhere), as their
-// feature rows at `params` give it, from the smallest scale's features alone on a search of its
-// own (a grid for the smallest k). A sample costs what it holds, plus the grid and, with area
-// weights, a spacing pass over the cloud. Checks and errors as compute_features.
+// feature rows at `params` give it, from the smallest scale of their lists on `search`, the
+// features' search (its k the largest scale). With `findings`, the lists (and, with area
+// weights, every point's spacings) are left there for the rows, so that a gate's sample is not
+// searched twice. Checks and errors as compute_features; glint::Error for a search of another k.
 std::vector<float> noise_statistics(const PointCloud& cloud, const FeatureParams& params,
-                                    std::span<const std::uint8_t> wanted);
+                                    const geometry::NeighbourhoodSearch& search,
+                                    std::span<const std::uint8_t> wanted,
+                                    SearchFindings* findings = nullptr);
 
 // Validates scales (>= 6, strictly decreasing); throws glint::Error naming the problem.
 void check_scales(const std::vector<int>& scales);

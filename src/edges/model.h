@@ -120,7 +120,7 @@ class GateTally {
 // points as the whole cloud. A sampling gate's 2^17 spacings put ln(P90 / P10) within a bin or
 // two of the whole cloud's; a noise gate's 2^14 feature rows put the share of quiet points
 // within about 1 % of it (binomial standard error at most 0.4 %) at the cost of 2^14 points'
-// features.
+// smallest-scale features (their lists are kept for the rows, see edges::SearchFindings).
 inline constexpr std::uint64_t kSamplingGatePoints = std::uint64_t(1) << 17;
 inline constexpr std::uint64_t kNoiseGatePoints = std::uint64_t(1) << 14;
 inline std::uint64_t gate_sample_size(GateKind kind) {

@@ -510,6 +510,8 @@ NeighbourhoodSearch::NeighbourhoodSearch(const PointCloud& cloud,
 
 NeighbourhoodSearch::~NeighbourhoodSearch() = default;
 
+int NeighbourhoodSearch::k() const { return state_->k; }
+
 namespace {
 
 // Throws when a mask of wanted points (empty: every point) does not fit the cloud.
@@ -795,6 +797,62 @@ std::vector<float> NeighbourhoodSearch::kth_nearest_squared_distances(
     if (progress) progress(grid.cell_begin[end_cell] - grid.cell_begin[first_cell]);
   });
   return result;
+}
+
+KeptNeighbourhoods::KeptNeighbourhoods(std::span<const std::uint8_t> wanted, int k) : k(k) {
+  for (std::size_t i = 0; i < wanted.size(); ++i)
+    if (wanted[i]) points.push_back(static_cast<std::uint32_t>(i));
+  neighbours = make_pool<std::uint32_t>(points.size() * std::size_t(k), "kept neighbourhoods");
+}
+
+void KeptNeighbourhoods::keep(const Neighbourhood& nb) {
+  const auto place = std::lower_bound(points.begin(), points.end(), nb.point);
+  if (nb.size != k || place == points.end() || *place != nb.point)
+    throw Error("", "kept neighbourhoods",
+                "point " + std::to_string(nb.point) + " with " + std::to_string(nb.size) +
+                    " neighbours has no place among the kept lists of " + std::to_string(k));
+  std::copy_n(nb.indices, k, neighbours.get() + (place - points.begin()) * k);
+}
+
+void visit_kept(const PointCloud& cloud, const KeptNeighbourhoods& kept,
+                const std::function<void(const Neighbourhood&)>& visit,
+                const std::function<void(std::size_t)>& progress, std::span<const float> values) {
+  if (!values.empty() && values.size() != cloud.size())
+    throw Error("", "kept neighbourhoods",
+                "has " + std::to_string(values.size()) + " values for " +
+                    std::to_string(cloud.size()) + " points");
+  const auto k = static_cast<std::size_t>(kept.k);
+  struct Lists {
+    std::vector<float> dx, dy, dz, values;
+  };
+  tbb::enumerable_thread_specific<Lists> lists([k] {
+    return Lists{std::vector<float>(k), std::vector<float>(k), std::vector<float>(k),
+                 std::vector<float>(k)};
+  });
+  parallel_for_chunks(kept.points.size(), 64, [&](std::size_t first, std::size_t end) {
+    Lists& list = lists.local();
+    for (std::size_t p = first; p < end; ++p) {
+      const std::uint32_t point = kept.points[p];
+      const std::uint32_t* indices = kept.neighbours.get() + p * k;
+      // As for_each: the neighbour's coordinate minus the query's, in float.
+      for (std::size_t j = 0; j < k; ++j) {
+        list.dx[j] = cloud.x[indices[j]] - cloud.x[point];
+        list.dy[j] = cloud.y[indices[j]] - cloud.y[point];
+        list.dz[j] = cloud.z[indices[j]] - cloud.z[point];
+        if (!values.empty()) list.values[j] = values[indices[j]];
+      }
+      Neighbourhood neighbourhood;
+      neighbourhood.point = point;
+      neighbourhood.size = kept.k;
+      neighbourhood.dx = list.dx.data();
+      neighbourhood.dy = list.dy.data();
+      neighbourhood.dz = list.dz.data();
+      neighbourhood.indices = indices;
+      neighbourhood.values = values.empty() ? nullptr : list.values.data();
+      visit(neighbourhood);
+    }
+    if (progress) progress(end - first);
+  });
 }
 
 NeighbourhoodStats for_each_neighbourhood(const PointCloud& cloud,

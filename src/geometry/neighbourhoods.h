@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/point_cloud.h"
+#include "core/pool_memory.h"
 
 namespace glint::geometry {
 
@@ -61,6 +62,9 @@ class NeighbourhoodSearch {
   NeighbourhoodSearch(const NeighbourhoodSearch&) = delete;
   NeighbourhoodSearch& operator=(const NeighbourhoodSearch&) = delete;
 
+  // The size of every neighbourhood for_each visits.
+  int k() const;
+
   // Calls visit(neighbourhood) once for every point, from several threads at once (the visitor
   // must be thread-safe; the Neighbourhood's arrays are valid only during the call).
   // progress(points_done) is called now and then from worker threads (may be empty).
@@ -89,6 +93,31 @@ class NeighbourhoodSearch {
   struct State;
   std::unique_ptr<State> state_;
 };
+
+// Neighbour lists of some points, kept from one pass of NeighbourhoodSearch::for_each so that a
+// later pass visits them without searching again (visit_kept).
+struct KeptNeighbourhoods {
+  int k = 0;
+  std::vector<std::uint32_t> points;  // the query points, increasing
+  // k per point, nearest first, in the order of points. Megabytes for a gate's sample: a pool on
+  // huge pages, since first touches of fresh 4 KiB pages cost about what a search of them does.
+  PoolArray<std::uint32_t> neighbours;
+
+  // Room for the lists of k neighbours of the points with a non-zero entry in `wanted`.
+  KeptNeighbourhoods(std::span<const std::uint8_t> wanted, int k);
+  KeptNeighbourhoods() = default;
+  // Copies nb's list to its point's place. nb.size must be k and nb.point one of `points`
+  // (glint::Error otherwise); safe from several threads for different points.
+  void keep(const Neighbourhood& nb);
+};
+
+// Visits every kept neighbourhood as for_each visited it: the same neighbours in the same order,
+// the same relative positions bit for bit, and their entries of `values` (one per point of the
+// cloud) when given. From several threads at once; progress(points_done) as for_each's.
+void visit_kept(const PointCloud& cloud, const KeptNeighbourhoods& kept,
+                const std::function<void(const Neighbourhood&)>& visit,
+                const std::function<void(std::size_t)>& progress = {},
+                std::span<const float> values = {});
 
 // NeighbourhoodSearch(cloud, params).for_each(visit, progress), for a single pass.
 NeighbourhoodStats for_each_neighbourhood(const PointCloud& cloud,

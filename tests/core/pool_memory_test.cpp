@@ -26,8 +26,14 @@ TEST(PoolMemory, PoolsAreZeroFilledAndWritable) {
 }
 
 TEST(PoolMemory, PoolsOfHugePagesStartOnAHugePageBoundary) {
-  const PoolArray<std::uint8_t> pool = make_pool<std::uint8_t>(std::size_t{5} << 20, "test pool");
-  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(pool.get()) % (std::size_t{2} << 20), 0u);
+  // 5 MiB, and a size that is no whole number of pages: the tail is as usable as the start.
+  for (std::size_t bytes : {std::size_t{5} << 20, (std::size_t{3} << 20) + 4097}) {
+    PoolArray<std::uint8_t> pool = make_pool<std::uint8_t>(bytes, "test pool");
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(pool.get()) % (std::size_t{2} << 20), 0u);
+    EXPECT_EQ(pool[bytes - 1], 0u);
+    pool[bytes - 1] = 7;
+    EXPECT_EQ(pool[bytes - 1], 7u);
+  }
 }
 
 TEST(PoolMemory, AnUnreservableSizeIsAnErrorNamingThePool) {

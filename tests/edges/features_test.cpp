@@ -198,6 +198,54 @@ TEST(Features, BlocksHoldEveryPointOnceWithTheMatrixRows) {
   EXPECT_THROW(compute_features_in_blocks(cloud, {}, 0, [](auto...) {}), glint::Error);
 }
 
+// A choice before the rows (a gate's) reads the noise statistic of some points and the spacings
+// of others on the features' search; the rows then reuse both, and come out as computed afresh.
+TEST(Features, RowsReuseWhatAChoiceFoundOnTheSearch) {
+  std::mt19937 rng(6);
+  PointCloud cloud;  // a density seam, so that area weights change the rows
+  add_patch(cloud, 30, 40, h, rng, [](float u, float v) { return Eigen::Vector3f(-u, v, 0.f); });
+  add_patch(cloud, 8, 10, 4 * h, rng,
+            [](float u, float v) { return Eigen::Vector3f(u + 4 * h, v, u); });
+  FeatureParams counted, weighted;
+  weighted.area_weights = true;
+  const FeatureMatrix by_count = compute_features(cloud, counted);
+  const FeatureMatrix by_area = compute_features(cloud, weighted);
+  std::vector<std::uint8_t> sampled(cloud.size(), 0), spaced(cloud.size(), 0);
+  for (std::size_t i = 0; i < cloud.size(); i += 3) sampled[i] = 1;
+  for (std::size_t i = 0; i < cloud.size(); i += 2) spaced[i] = 1;
+  std::vector<float> statistics;
+  std::mutex mutex;
+  std::size_t mismatches = 0, rows = 0;
+  compute_features_in_blocks(
+      cloud, counted, 64,
+      [&](const std::uint32_t* points, const float* block, std::size_t count) {
+        std::lock_guard<std::mutex> lock(mutex);
+        rows += count;
+        for (std::size_t b = 0; b < count; ++b)
+          for (std::size_t c = 0; c < by_area.row_size(); ++c)
+            mismatches += block[b * by_area.row_size() + c] != by_area.row(points[b])[c];
+      },
+      [&](const geometry::NeighbourhoodSearch& search, SearchFindings& findings) {
+        statistics = noise_statistics(cloud, counted, search, sampled, &findings);
+        findings.spacings = search.kth_nearest_squared_distances(
+            area_spacing_neighbours(cloud.size()), {}, spaced);
+        findings.spaced = spaced;
+        EXPECT_EQ(findings.neighbourhoods.points.size(), (cloud.size() + 2) / 3);
+        return weighted;
+      });
+  EXPECT_EQ(rows, cloud.size());
+  EXPECT_EQ(mismatches, 0u);
+  // The statistic is the smallest scale's of the full rows, at the sampled points only.
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    ASSERT_EQ(statistics[i], sampled[i] ? noise_statistic(by_count.row(i), 4, 12) : 0.0f) << i;
+  // A search of another k and a mask that does not fit the cloud are refused.
+  const geometry::NeighbourhoodSearch smaller(cloud, feature_search_params({64, 32}));
+  EXPECT_THROW(noise_statistics(cloud, counted, smaller, sampled), glint::Error);
+  const geometry::NeighbourhoodSearch search(cloud, feature_search_params(counted.scales));
+  sampled.pop_back();
+  EXPECT_THROW(noise_statistics(cloud, counted, search, sampled), glint::Error);
+}
+
 TEST(Features, RejectsBadInputs) {
   PointCloud small;
   for (int i = 0; i < 100; ++i) small.push_back(float(i), 0.f, float(i % 7));

@@ -252,5 +252,64 @@ TEST(Neighbourhoods, CarriedValuesFollowTheirNeighbours) {
   EXPECT_THROW(search.for_each([](const Neighbourhood&) {}, {}, values), glint::Error);
 }
 
+TEST(Neighbourhoods, KeptListsAreVisitedAgainAsTheSearchVisitedThem) {
+  // Every fifth point's lists kept (outliers' k-d tree answers included), then visited from the
+  // lists: the same neighbours, relative positions and carried values, bit for bit.
+  const PointCloud cloud = uneven_cloud();
+  std::vector<float> values(cloud.size());
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = 0.25f * float(i);
+  NeighbourhoodParams params;
+  params.k = 48;
+  const NeighbourhoodSearch search(cloud, params);
+  EXPECT_EQ(search.k(), 48);
+  std::vector<std::uint8_t> wanted(cloud.size(), 0);
+  for (std::size_t i = 0; i < cloud.size(); i += 5) wanted[i] = 1;
+  wanted.back() = 1;  // an outlier
+  using List = std::vector<float>;  // dx, dy, dz, value and index of each neighbour in turn
+  const auto record = [](std::vector<List>& lists) {
+    return [&lists](const Neighbourhood& nb) {
+      List& list = lists[nb.point];
+      for (int j = 0; j < nb.size; ++j)
+        list.insert(list.end(),
+                    {nb.dx[j], nb.dy[j], nb.dz[j], nb.values[j], float(nb.indices[j])});
+    };
+  };
+  KeptNeighbourhoods kept(wanted, search.k());
+  std::vector<List> searched(cloud.size()), replayed(cloud.size());
+  std::mutex mutex;
+  search.for_each(
+      [&](const Neighbourhood& nb) {
+        kept.keep(nb);
+        const std::lock_guard<std::mutex> lock(mutex);
+        record(searched)(nb);
+      },
+      {}, values, wanted);
+  std::atomic<std::size_t> done{0};
+  visit_kept(
+      cloud, kept,
+      [&](const Neighbourhood& nb) {
+        const std::lock_guard<std::mutex> lock(mutex);
+        record(replayed)(nb);
+      },
+      [&](std::size_t points) { done += points; }, values);
+  EXPECT_EQ(done, kept.points.size());
+  std::size_t wrong = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    wrong += replayed[i] != searched[i] || replayed[i].empty() == bool(wanted[i]);
+  EXPECT_EQ(wrong, 0u);
+  // Without values none are handed out; a list of another size, a point without a place and
+  // values that do not fit the cloud are refused.
+  visit_kept(cloud, kept, [](const Neighbourhood& nb) { EXPECT_EQ(nb.values, nullptr); });
+  Neighbourhood stranger;
+  stranger.point = 1;  // not wanted
+  stranger.size = search.k();
+  EXPECT_THROW(kept.keep(stranger), glint::Error);
+  stranger.point = 0;
+  stranger.size = 8;
+  EXPECT_THROW(kept.keep(stranger), glint::Error);
+  values.pop_back();
+  EXPECT_THROW(visit_kept(cloud, kept, [](const Neighbourhood&) {}, {}, values), glint::Error);
+}
+
 }  // namespace
 }  // namespace glint::geometry
