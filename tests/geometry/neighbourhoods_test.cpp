@@ -31,6 +31,13 @@ PointCloud uneven_cloud() {
   return cloud;
 }
 
+// One value per point, `step` times its index: a neighbour's value tells which point it is.
+std::vector<float> index_values(const PointCloud& cloud, float step) {
+  std::vector<float> values(cloud.size());
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = step * float(i);
+  return values;
+}
+
 float squared_distance(const PointCloud& c, std::uint32_t a, std::uint32_t b) {
   const float dx = c.x[a] - c.x[b], dy = c.y[a] - c.y[b], dz = c.z[a] - c.z[b];
   return dx * dx + dy * dy + dz * dz;
@@ -229,11 +236,8 @@ TEST(Neighbourhoods, KthDistancesRefuseBadK) {
 TEST(Neighbourhoods, CarriedValuesFollowTheirNeighbours) {
   // Every neighbour's value must be its own point's, also for the outliers' k-d tree answers.
   const PointCloud cloud = uneven_cloud();
-  std::vector<float> values(cloud.size());
-  for (std::size_t i = 0; i < values.size(); ++i) values[i] = 0.5f * float(i);
-  NeighbourhoodParams params;
-  params.k = 32;
-  const NeighbourhoodSearch search(cloud, params);
+  std::vector<float> values = index_values(cloud, 0.5f);
+  const NeighbourhoodSearch search(cloud, NeighbourhoodParams{32});
   std::atomic<std::size_t> wrong{0}, visited{0};
   const NeighbourhoodStats stats = search.for_each(
       [&](const Neighbourhood& nb) {
@@ -256,22 +260,18 @@ TEST(Neighbourhoods, KeptListsAreVisitedAgainAsTheSearchVisitedThem) {
   // Every fifth point's lists kept (outliers' k-d tree answers included), then visited from the
   // lists: the same neighbours, relative positions and carried values, bit for bit.
   const PointCloud cloud = uneven_cloud();
-  std::vector<float> values(cloud.size());
-  for (std::size_t i = 0; i < values.size(); ++i) values[i] = 0.25f * float(i);
-  NeighbourhoodParams params;
-  params.k = 48;
-  const NeighbourhoodSearch search(cloud, params);
+  std::vector<float> values = index_values(cloud, 0.25f);
+  const NeighbourhoodSearch search(cloud, NeighbourhoodParams{48});
   EXPECT_EQ(search.k(), 48);
   std::vector<std::uint8_t> wanted(cloud.size(), 0);
   for (std::size_t i = 0; i < cloud.size(); i += 5) wanted[i] = 1;
-  wanted.back() = 1;  // an outlier
+  wanted.back() = 1;                // an outlier
   using List = std::vector<float>;  // dx, dy, dz, value and index of each neighbour in turn
   const auto record = [](std::vector<List>& lists) {
     return [&lists](const Neighbourhood& nb) {
       List& list = lists[nb.point];
       for (int j = 0; j < nb.size; ++j)
-        list.insert(list.end(),
-                    {nb.dx[j], nb.dy[j], nb.dz[j], nb.values[j], float(nb.indices[j])});
+        list.insert(list.end(), {nb.dx[j], nb.dy[j], nb.dz[j], nb.values[j], float(nb.indices[j])});
     };
   };
   KeptNeighbourhoods kept(wanted, search.k());
@@ -308,7 +308,9 @@ TEST(Neighbourhoods, KeptListsAreVisitedAgainAsTheSearchVisitedThem) {
   stranger.size = 8;
   EXPECT_THROW(kept.keep(stranger), glint::Error);
   values.pop_back();
-  EXPECT_THROW(visit_kept(cloud, kept, [](const Neighbourhood&) {}, {}, values), glint::Error);
+  EXPECT_THROW(visit_kept(
+                   cloud, kept, [](const Neighbourhood&) {}, {}, values),
+               glint::Error);
 }
 
 }  // namespace
