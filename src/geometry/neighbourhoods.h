@@ -9,7 +9,8 @@
 // nearest bucket-sorted, reusing the previous query's k-th distance as the bucket range. A
 // query is accepted only when its k-th distance is inside the block's guaranteed radius, so
 // the result is exact; the few that are not (sparse regions, outliers) retry on a 9×9×9 block
-// and then fall back to a k-d tree. Lists are handed to the visitor and never all stored.
+// and then fall back to a k-d tree. Lists are handed to the visitor and never all stored (a
+// caller may keep a sample's, KeptNeighbourhoods).
 #include <cstdint>
 #include <functional>
 #include <memory>
