@@ -4,8 +4,8 @@
 // (k = 128) on the same cloud, and the time for every cloud of a folder (default: default-eval).
 // Writes JSON (stdout, or --json FILE) with the machine and the parameters it ran with.
 //
-//   edges_throughput [--points 1000000] [--model models/bounded-3c.json] [--data DIR] [--json F]
-//                    [--repeat 1]
+//   edges_throughput [--points 1000000] [--model MODEL] [--data DIR] [--json F] [--repeat 1]
+// MODEL defaults to the shipped bounded-3c.json (the models folder, as glint finds it).
 // --repeat N classifies and searches N times and reports the median (and every run): on a
 // shared host single runs of the same binary vary by a quarter.
 
@@ -14,11 +14,13 @@
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "core/parallel.h"
+#include "core/resources.h"
 #include "core/timer.h"
 #include "edges/classifier.h"
 #include "edges/covariance_baseline.h"
@@ -57,18 +59,33 @@ std::string arg_value(int argc, char** argv, const std::string& name, const std:
   return fallback;
 }
 
-}  // namespace
+// A whole-number option; a value that is not one is an error naming the option.
+std::size_t count_value(int argc, char** argv, const std::string& name, std::size_t fallback) {
+  const std::string value = arg_value(argc, argv, name, std::to_string(fallback));
+  std::size_t used = 0;
+  unsigned long long count = 0;
+  try {
+    count = std::stoull(value, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != value.size() || value.front() == '-')
+    throw std::runtime_error(name + ": '" + value + "' is not a whole number");
+  return static_cast<std::size_t>(count);
+}
 
-int main(int argc, char** argv) {
-  const std::size_t points = std::stoull(arg_value(argc, argv, "--points", "1000000"));
-  const std::string model_path = arg_value(argc, argv, "--model", "models/bounded-3c.json");
+int run(int argc, char** argv) {
+  const std::size_t points = count_value(argc, argv, "--points", 1000000);
+  const std::string model_path =
+      arg_value(argc, argv, "--model", glint::model_path("bounded-3c.json").string());
   const char* env_data = std::getenv("GLINT_DATA");
   const std::string data_root =
       arg_value(argc, argv, "--data", env_data ? env_data : "../shared/data");
   const std::string folder =
       arg_value(argc, argv, "--folder", data_root + "/pointclouds/default-eval");
   const std::string json_path = arg_value(argc, argv, "--json", "");
-  const int repeat = std::max(1, std::stoi(arg_value(argc, argv, "--repeat", "1")));
+  const int repeat =
+      static_cast<int>(std::max<std::size_t>(1, count_value(argc, argv, "--repeat", 1)));
 
   nlohmann::json report;
   report["machine"] = {{"cpu", glint::bench::cpu_model()},
@@ -176,4 +193,16 @@ int main(int argc, char** argv) {
   if (!json_path.empty()) glint::io::write_json(json_path, report);
   std::cout << report.dump(2) << "\n";
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // One line and a non-zero exit for a missing model or data folder, a bad number.
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "edges_throughput: error: " << e.what() << "\n";
+    return 1;
+  }
 }
