@@ -13,6 +13,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <numbers>
 #include <random>
 #include <span>
 #include <string>
@@ -85,9 +86,31 @@ double quantile(std::vector<double> values, double q) {
   return values[at];
 }
 
-// A high quantile of the k-th neighbour distance, from a k-d tree over a subsample whose
-// neighbour count is scaled by the sampling rate (surface-like density assumed); the grid cells
-// are sized from it.
+// A first cell size for a grid over `cloud` that answers k nearest neighbours: the k-th
+// neighbour distance if the points covered the surface of their bounding box evenly. Only speed
+// depends on it (queries are exact whatever the cell).
+double surface_guess(const PointCloud& cloud, int k) {
+  double extent[3];
+  const std::vector<float>* axes[3] = {&cloud.x, &cloud.y, &cloud.z};
+  for (int a = 0; a < 3; ++a) {
+    const auto [low, high] = std::minmax_element(axes[a]->begin(), axes[a]->end());
+    extent[a] = double(*high) - double(*low);
+  }
+  const double area = 2.0 * (extent[0] * extent[1] + extent[1] * extent[2] + extent[2] * extent[0]);
+  const double n = double(cloud.size());
+  // Collinear points: the k-th neighbour lies about k / n of the line away.
+  const double guess = area > 0 ? std::sqrt(area * double(k) / (std::numbers::pi * n))
+                                : std::max({extent[0], extent[1], extent[2]}) * double(k) / n;
+  // Coincident points (and non-finite ones, which the callers refuse) get any positive size: a
+  // size of 0 would ask for this estimate again.
+  return std::isfinite(guess) && guess > 0 ? guess : 1.0;
+}
+
+// A high quantile of the k-th neighbour distance over a subsample whose neighbour count is scaled
+// by the sampling rate (surface-like density assumed); the grid cells are sized from it. The
+// sample's k-th distances are exact (a grid over the sample sized by surface_guess), computed as
+// (x_j - x_q)² + (y_j - y_q)² + (z_j - z_q)² in float like a k-d tree's, so the cell size does not
+// depend on how they were found.
 double high_kth_distance(const PointCloud& cloud, int k) {
   const std::size_t n = cloud.size();
   const std::size_t m = std::min<std::size_t>(n, std::max<std::size_t>(20000, n / 8));
@@ -105,17 +128,17 @@ double high_kth_distance(const PointCloud& cloud, int k) {
   // The sample's k_sample-th neighbour sits at about the full cloud's (k_sample·n/m)-th; for a
   // surface the radius grows with the square root of the count.
   const double correction = std::sqrt(double(k) * double(m) / (double(n) * double(k_sample)));
-  KdTree tree(sample);
   const std::size_t queries = std::min<std::size_t>(m, 512);
+  std::vector<std::uint8_t> queried(m, 0);
+  for (std::size_t q = 0; q < queries; ++q) queried[q * m / queries] = 1;
+  NeighbourhoodParams params;
+  params.k = k_sample;
+  params.cell_size = surface_guess(sample, k_sample);
+  const std::vector<float> kth =
+      NeighbourhoodSearch(sample, params).kth_nearest_squared_distances(k_sample, {}, queried);
   std::vector<double> radii(queries);
-  parallel_for(queries, [&](std::size_t q) {
-    const std::size_t i = q * m / queries;
-    const float point[3] = {sample.x[i], sample.y[i], sample.z[i]};
-    std::vector<std::uint32_t> indices(k_sample);
-    std::vector<float> distances(k_sample);
-    const int found = tree.knn(point, k_sample, indices.data(), distances.data());
-    radii[q] = std::sqrt(double(distances[found - 1])) * correction;
-  });
+  for (std::size_t q = 0; q < queries; ++q)
+    radii[q] = std::sqrt(double(kth[q * m / queries])) * correction;
   return quantile(std::move(radii), 0.9);
 }
 
@@ -738,9 +761,10 @@ std::vector<float> NeighbourhoodSearch::kth_nearest_squared_distances(
     std::span<const std::uint8_t> wanted) const {
   const PointCloud& cloud = state_->cloud;
   const Grid& grid = state_->grid;
-  if (k < 1 || k > kMaxSmallK) {
+  const int largest_k = std::max(kMaxSmallK, state_->k);
+  if (k < 1 || k > largest_k) {
     throw Error("", "k-th neighbour distances",
-                "k must be between 1 and " + std::to_string(kMaxSmallK));
+                "k must be between 1 and " + std::to_string(largest_k));
   }
   if (cloud.size() < static_cast<std::size_t>(k)) {
     throw Error("", "k-th neighbour distances",

@@ -49,7 +49,8 @@ struct NeighbourhoodStats {
   std::size_t fallback_queries = 0;  // needed the k-d tree
 };
 
-// The largest k for NeighbourhoodSearch::kth_nearest_squared_distances.
+// The largest k for NeighbourhoodSearch::kth_nearest_squared_distances, where the search's own
+// k is smaller.
 inline constexpr int kMaxSmallK = 32;
 
 // A cloud bucketed once for exact neighbourhoods of params.k points; the same grid also
@@ -83,9 +84,9 @@ class NeighbourhoodSearch {
   // cell around a query's cell and a running list of the k smallest replace the sorted lists.
   // Computed as (x_j - x_q)² + (y_j - y_q)² + (z_j - z_q)² in float without fused multiply-adds,
   // as a visitor of for_each computes it from dx, dy, dz. Throws glint::Error when k is outside
-  // [1, kMaxSmallK] or the cloud has fewer than k points, or when `wanted` is given with another
-  // size than the cloud's. With `wanted`, only the points with a non-zero entry are queried (a
-  // sample costs what it holds, not the cloud); the other entries are 0.
+  // [1, max(kMaxSmallK, k())] or the cloud has fewer than k points, or when `wanted` is given
+  // with another size than the cloud's. With `wanted`, only the points with a non-zero entry are
+  // queried (a sample costs what it holds, not the cloud); the other entries are 0.
   std::vector<float> kth_nearest_squared_distances(
       int k, const std::function<void(std::size_t)>& progress = {},
       std::span<const std::uint8_t> wanted = {}) const;

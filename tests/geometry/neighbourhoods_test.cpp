@@ -313,5 +313,33 @@ TEST(Neighbourhoods, KeptListsAreVisitedAgainAsTheSearchVisitedThem) {
                glint::Error);
 }
 
+TEST(Neighbourhoods, CellsAreSizedFromTheExactKthDistances) {
+  // Clouds under 20,000 points are their own sample: the cell is half the 0.9 quantile of the
+  // k-th neighbour distance of every (n / 512)-th point, the distances as a k-d tree finds them
+  // (uneven: the retries and the k-d tree fallback inside; a lattice: ties everywhere).
+  PointCloud lattice;
+  for (int y = 0; y < 60; ++y)
+    for (int x = 0; x < 70; ++x) lattice.push_back(0.5f * float(x), 0.25f * float(y), 0.f);
+  for (const PointCloud& cloud : {uneven_cloud(), lattice}) {
+    for (const int k : {16, 64, 128}) {
+      const KdTree tree(cloud);
+      const std::size_t queries = 512;
+      std::vector<double> radii;
+      std::vector<std::uint32_t> indices(k);
+      std::vector<float> distances(k);
+      for (std::size_t q = 0; q < queries; ++q) {
+        const std::size_t i = q * cloud.size() / queries;
+        const float point[3] = {cloud.x[i], cloud.y[i], cloud.z[i]};
+        tree.knn(point, k, indices.data(), distances.data());
+        radii.push_back(std::sqrt(double(distances[k - 1])));
+      }
+      std::nth_element(radii.begin(), radii.begin() + 459, radii.end());  // 0.9 · 511
+      const NeighbourhoodStats stats =
+          NeighbourhoodSearch(cloud, NeighbourhoodParams{k}).for_each([](const Neighbourhood&) {});
+      EXPECT_EQ(stats.cell_size, radii[459] / 2) << cloud.size() << " points, k = " << k;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace glint::geometry
