@@ -515,9 +515,9 @@ std::vector<float> noise_statistics(const PointCloud& cloud, const FeatureParams
   smallest.scales = {params.scales.back()};
   const PointKernel kernel = point_kernel();
   const SearchFindings none;
-  const std::vector<float> spacings =
-      params.area_weights ? squared_spacings(cloud, search, findings ? *findings : none)
-                          : std::vector<float>();
+  std::vector<float> spacings = params.area_weights
+                                    ? squared_spacings(cloud, search, findings ? *findings : none)
+                                    : std::vector<float>();
   geometry::KeptNeighbourhoods kept;
   if (findings) kept = geometry::KeptNeighbourhoods(wanted, search.k());
   std::vector<float> statistics(cloud.size(), 0.0f);
@@ -537,7 +537,7 @@ std::vector<float> noise_statistics(const PointCloud& cloud, const FeatureParams
   if (findings) {
     findings->neighbourhoods = std::move(kept);
     if (params.area_weights) {
-      findings->spacings = spacings;
+      findings->spacings = std::move(spacings);
       findings->spaced.assign(cloud.size(), 1);
     }
   }
